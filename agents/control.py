@@ -1,0 +1,78 @@
+"""The coverage control law of Section III: local (eq. 7–9), global (eq. 10–11), combined (eq. 12–16).
+
+Two readings of the paper are selectable (see docs/paper-notes.md):
+
+- ``literal_heading``: eq. 11 as printed, θ_glo* = atan2(p_i − p_obj), which
+  points *away* from the objective; otherwise atan2(p_obj − p_i).
+- ``literal_omega``: eq. 16 as printed, ω = k_ω e_θ (1 − u_glo); otherwise
+  ω = k_ω e_θ, which keeps the stated bound |ω| ≤ k_ω π and lets an agent
+  far from its objective turn.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from agents.geometry import wrap_angle
+
+
+@njit(cache=True)
+def local_law(e_omega: float, w_left: float, w_right: float, theta: float, half_angle: float) -> tuple[float, float]:
+    """Local law (u_loc, θ_loc*), eq. 7–9.
+
+    u_loc = 1 − e_Ω (eq. 7). Eq. 9 gives the derivative of the covering rate
+    with respect to θ_i, not a heading; we take a normalised gradient step:
+    θ_loc* = θ_i + F (w_left − w_right)/(w_left + w_right), so a view that is
+    uncovered on one side only turns the heading by the half angle F toward
+    it, and a balanced view (∂ẽ/∂θ_i = 0) keeps it.
+    """
+    u_loc = 1.0 - e_omega
+    total = w_left + w_right
+    if total <= 0.0:
+        return u_loc, theta
+    return u_loc, wrap_angle(theta + half_angle * (w_left - w_right) / total)
+
+
+@njit(cache=True)
+def global_law(
+    x: float, y: float, objective_x: float, objective_y: float, sensing_range: float, literal_heading: bool
+) -> tuple[float, float]:
+    """Global law (u_glo, θ_glo*), eq. 10–11: speed from distance to the objective, heading toward it."""
+    dx = objective_x - x
+    dy = objective_y - y
+    u_glo = (2.0 / math.pi) * math.atan(math.sqrt(dx * dx + dy * dy) - sensing_range / 2.0)
+    if literal_heading:
+        return u_glo, math.atan2(-dy, -dx)
+    return u_glo, math.atan2(dy, dx)
+
+
+@njit(cache=True)
+def combined_law(
+    theta: float,
+    e_omega: float,
+    u_loc: float,
+    theta_loc: float,
+    u_glo: float,
+    theta_glo: float,
+    beta: float,
+    k_v: float,
+    k_omega: float,
+    literal_omega: bool,
+) -> tuple[float, float]:
+    """Velocities (v, ω) from the weighted laws, eq. 12–16.
+
+    W_loc = e_Ω^β, W_glo = 1 − W_loc (eq. 12–13); e_θ is the weighted sum of
+    the wrapped heading errors (eq. 14). Eq. 15 uses |e_θ| so that
+    v ∈ [−k_v, k_v] as the paper states.
+    """
+    w_loc = e_omega**beta
+    w_glo = 1.0 - w_loc
+    e_theta = wrap_angle(theta_loc - theta) * w_loc + wrap_angle(theta_glo - theta) * w_glo
+    v = k_v * (u_loc * w_loc + u_glo * w_glo) * (1.0 - (2.0 / math.pi) * abs(e_theta))
+    if literal_omega:
+        omega = k_omega * e_theta * (1.0 - u_glo)
+    else:
+        omega = k_omega * e_theta
+    return v, omega

@@ -1,0 +1,110 @@
+"""Wedge sensing (eq. 2): what an agent observes (eq. 6, 9) and the coverage it adds (eq. 3).
+
+The map is a grid of cells of side ``cell``; cell (row, col) has its centre at
+((col + ½)·cell, (row + ½)·cell). Coverage is held in fixed-point ticks
+(:mod:`protocol.fixed_point`) so deltas from different agents commute exactly.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from agents.geometry import wedge_cell_range
+from protocol.fixed_point import COVERAGE_SCALE
+
+
+@njit(cache=True)
+def sensing_ability(
+    distance: float, bearing_offset: float, sensing_range: float, half_angle: float, alpha_max: float
+) -> float:
+    """Sensing ability α_i(r, θ_ix) of a wedge camera, eq. 2 (θ_ix = |θ_i − θ_x| ≥ 0)."""
+    if distance <= sensing_range and bearing_offset <= half_angle:
+        return alpha_max * (sensing_range - distance) * (half_angle - bearing_offset) / (sensing_range * half_angle)
+    return 0.0
+
+
+@njit(cache=True)
+def lack_of_coverage(coverage_ticks: int, target_ticks: int) -> float:
+    """Lack of coverage Υ = max(0, 1 − Λ/Λ*), eq. 4, from fixed-point ticks."""
+    if coverage_ticks >= target_ticks:
+        return 0.0
+    return (target_ticks - coverage_ticks) / target_ticks
+
+
+@njit(cache=True)
+def sense_wedge(
+    coverage: np.ndarray,
+    target_ticks: int,
+    x: float,
+    y: float,
+    theta: float,
+    sensing_range: float,
+    half_angle: float,
+    alpha_max: float,
+    dt: float,
+    cell: float,
+) -> tuple[float, float, float, int, int, np.ndarray]:
+    """One pass over agent i's wedge Ω_i: what it reads from the map and what it adds to it.
+
+    Returns (e_Ω, w_left, w_right, row0, col0, ticks):
+
+    - e_Ω, eq. 6: mean lack of coverage over the wedge's cells. Cells outside
+      the domain are in the wedge (S_Ω is the area the camera sees) but have
+      nothing left to cover, Υ = 0.
+    - w_left, w_right: the integral of eq. 9 split by side. Over uncovered
+      cells (Ω − Υ₀) the integrand (R − r)(θ_i − θ_x)/(R F θ_ix) is
+      ±(R − r)/(R F); w_left sums (R − r)/(R F)·cell² over uncovered cells to
+      the left of the heading (θ_x > θ_i), w_right those to the right, so
+      ∂ẽ/∂θ_i = (w_right − w_left)/Λ*.
+    - the coverage delta of eq. 3, Λ += α_i·dt, as a window of fixed-point
+      ticks clipped to the grid, whose top-left cell is (row0, col0). The
+      map is only read here: deltas are applied once every agent has read.
+    """
+    rows, cols = coverage.shape
+    row0, row1, col0, col1 = wedge_cell_range(x, y, theta, sensing_range, half_angle, cell)
+    clip_row0, clip_col0 = max(row0, 0), max(col0, 0)
+    height = max(min(row1, rows) - clip_row0, 0)
+    width = max(min(col1, cols) - clip_col0, 0)
+    ticks = np.zeros((height, width), dtype=np.int64)
+    heading_x, heading_y = math.cos(theta), math.sin(theta)
+    cos_half_angle = math.cos(half_angle)
+    tick_scale = dt * COVERAGE_SCALE
+    area_weight = cell * cell / (sensing_range * half_angle)
+    cells_in_wedge = 0
+    lack_sum = 0.0
+    w_left = 0.0
+    w_right = 0.0
+    for row in range(row0, row1):
+        cy = (row + 0.5) * cell - y
+        row_inside = 0 <= row < rows
+        for col in range(col0, col1):
+            cx = (col + 0.5) * cell - x
+            distance = math.sqrt(cx * cx + cy * cy)
+            if distance > sensing_range:
+                continue
+            along = cx * heading_x + cy * heading_y
+            across = heading_x * cy - heading_y * cx  # > 0: the cell is left of the heading
+            # Cheap rejection before the arctangent: outside the cone cos(offset) < cos F.
+            if along < distance * cos_half_angle - 1e-12:
+                continue
+            offset = abs(math.atan2(across, along)) if distance > 0.0 else 0.0
+            if offset > half_angle:
+                continue
+            cells_in_wedge += 1
+            if not row_inside or col < 0 or col >= cols:
+                continue
+            ability = sensing_ability(distance, offset, sensing_range, half_angle, alpha_max)
+            ticks[row - clip_row0, col - clip_col0] = int(ability * tick_scale + 0.5)
+            lack = lack_of_coverage(coverage[row, col], target_ticks)
+            if lack > 0.0:
+                lack_sum += lack
+                weight = (sensing_range - distance) * area_weight
+                if across > 0.0:
+                    w_left += weight
+                elif across < 0.0:
+                    w_right += weight
+    e_omega = lack_sum / cells_in_wedge if cells_in_wedge > 0 else 0.0
+    return e_omega, w_left, w_right, clip_row0, clip_col0, ticks

@@ -1,0 +1,79 @@
+"""The zig-zag baseline of Fig. 7–8: lanes swept at full speed on the same unicycle and sensor.
+
+Lanes run along x, from −R to W + R (length W + 2R = 140 for the paper's
+domain), so every point of a lane's strip passes through the whole wedge.
+The first and last lanes lie d100 from the domain's edges (the distance at
+which one straight pass reaches Λ*), the rest evenly between. At each lane
+end the robot turns in place by 90°, moves to the next lane, and turns 90°
+again, at |ω| = k_ω π/2: one time unit per 90° turn, which is what the
+paper's t₁ = 2080.6 adds to its path of 2054.6 (docs/paper-notes.md, reading 3).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from agents.geometry import wrap_angle
+
+HEADING_TOLERANCE = 1e-6
+"""Below this heading error (rad) the pilot drives instead of turning."""
+POSITION_TOLERANCE = 1e-6
+"""Within this distance (units) a waypoint counts as reached."""
+
+
+def lane_offsets(height: float, edge_offset: float, lane_spacing_limit: float) -> np.ndarray:
+    """Lane positions across the domain: first and last ``edge_offset`` from the edges,
+    as few lanes as keep neighbours at most ``lane_spacing_limit`` apart."""
+    span = height - 2.0 * edge_offset
+    gaps = max(1, math.ceil(span / lane_spacing_limit - 1e-9))
+    return edge_offset + np.arange(gaps + 1) * (span / gaps)
+
+
+def zigzag_waypoints(width: float, lanes: np.ndarray, overhang: float, first_lane_index: int) -> np.ndarray:
+    """Waypoints (K, 2) of a boustrophedon over ``lanes``; even global lane indices go +x."""
+    points = []
+    for offset, lane_y in enumerate(lanes):
+        eastward = (first_lane_index + offset) % 2 == 0
+        start, end = (-overhang, width + overhang) if eastward else (width + overhang, -overhang)
+        points.append((start, lane_y))
+        points.append((end, lane_y))
+    return np.array(points, dtype=np.float64)
+
+
+def split_lanes(lanes: np.ndarray, agents: int) -> list[tuple[int, np.ndarray]]:
+    """Contiguous blocks of lanes, one per agent: (index of the block's first lane, lanes)."""
+    blocks = np.array_split(np.arange(len(lanes)), agents)
+    return [(int(block[0]) if block.size else 0, lanes[block]) for block in blocks]
+
+
+@dataclass
+class WaypointPilot:
+    """Follows waypoints as a unicycle: turn in place toward the next one, then drive straight."""
+
+    waypoints: np.ndarray
+    k_v: float
+    turn_rate: float
+    dt: float
+    next_index: int = 0
+
+    @property
+    def finished(self) -> bool:
+        return self.next_index >= len(self.waypoints)
+
+    def velocities(self, x: float, y: float, theta: float) -> tuple[float, float]:
+        """(v, ω) for the coming step; (0, 0) once the last waypoint is reached."""
+        while not self.finished:
+            target_x, target_y = self.waypoints[self.next_index]
+            distance = math.hypot(target_x - x, target_y - y)
+            if distance < POSITION_TOLERANCE:
+                self.next_index += 1
+                continue
+            heading_error = wrap_angle(math.atan2(target_y - y, target_x - x) - theta)
+            if abs(heading_error) > HEADING_TOLERANCE:
+                turn = min(self.turn_rate, abs(heading_error) / self.dt)
+                return 0.0, math.copysign(turn, heading_error)
+            return min(self.k_v, distance / self.dt), heading_error / self.dt
+        return 0.0, 0.0

@@ -1,0 +1,329 @@
+"""The in-process engine: a whole team on one map, no bus, the same control code as the agents.
+
+One step k (time t_k = k·dt), the same in the engine and over Zenoh in lockstep:
+
+1. every ``replan_steps`` steps the coordinator's part runs on the map and
+   poses at t_k: Algorithm 1 (objectives) then Algorithm 2 (assignment);
+2. every agent decides (v, ω) from the map Λ_k, its pose and its objective;
+3. every agent senses at its pose: Λ_{k+1} = Λ_k + Σ_i α_i·dt (eq. 3);
+4. every agent moves by eq. 1.
+
+The run ends when no cell is left uncovered (or at ``max_time``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+from numba.typed import List
+
+from agents.step import LawParameters, decide_and_sense, move, sense_only
+from agents.zigzag import WaypointPilot, lane_offsets, split_lanes, zigzag_waypoints
+from anicov.metrics import coverage_distance
+from anicov.scenario import Scenario
+from coordinator.assignment import assign_objectives
+from coordinator.objectives import BlobObjectives, fallback_objective, select_objectives
+from protocol.coverage_map import CoverageMap, add_window
+
+TRACE_FIELDS = ("x", "y", "theta", "v", "omega", "e_omega")
+"""Columns of the per-step trace: pose at the start of the step, then what was applied during it."""
+
+SNAPSHOT_PERIOD = 5.0
+"""Time between stored lack-of-coverage snapshots (for Fig. 6 and the recording)."""
+
+
+def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParameters:
+    """The control and sensing parameters of a scenario."""
+    return LawParameters(
+        sensing_range=scenario.range,
+        half_angle=scenario.half_angle,
+        alpha_max=scenario.alpha_max,
+        beta=scenario.beta,
+        k_v=scenario.k_v,
+        k_omega=scenario.k_omega,
+        dt=scenario.dt,
+        cell=scenario.cell,
+        target_ticks=coverage_map.target_ticks,
+        literal_heading=scenario.controller == "paper-literal",
+        literal_omega=scenario.controller == "paper-literal",
+    )
+
+
+def initial_poses(scenario: Scenario) -> np.ndarray:
+    """Poses (N, 3) drawn uniformly in the domain and in (−π, π] from the scenario's seed."""
+    rng = np.random.default_rng(scenario.seed)
+    width, height = scenario.domain
+    x = rng.uniform(0.0, width, scenario.agents)
+    y = rng.uniform(0.0, height, scenario.agents)
+    theta = rng.uniform(-math.pi, math.pi, scenario.agents)
+    return np.stack([x, y, theta], axis=1)
+
+
+@dataclass
+class Planner:
+    """The coordinator's part: Algorithm 1 then Algorithm 2, with objectives kept between calls."""
+
+    scenario: Scenario
+    blobs: BlobObjectives = field(default_factory=BlobObjectives)
+
+    def plan(self, lack: np.ndarray, positions: np.ndarray) -> np.ndarray:
+        """Objective (x, y) for every agent, shape (N, 2)."""
+        self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range)
+        objectives = self.blobs.positions
+        if len(objectives) == 0:
+            fallback = fallback_objective(lack, positions, self.scenario.cell)
+            if fallback is None:
+                return positions.copy()
+            objectives = fallback[None, :]
+        return objectives[assign_objectives(positions, objectives)]
+
+
+@njit(cache=True)
+def advance_team(
+    coverage: np.ndarray,
+    poses: np.ndarray,
+    objectives: np.ndarray,
+    law: LawParameters,
+    steps: int,
+    uncovered: int,
+    deficit: int,
+    trace: np.ndarray,
+    errors: np.ndarray,
+) -> tuple[int, int, int]:
+    """Run up to ``steps`` steps of the paper's law for the whole team; stop early at full coverage.
+
+    Writes the per-step trace (TRACE_FIELDS) and e_D after each step; returns
+    (steps done, uncovered cells, deficit ticks).
+    """
+    rows, cols = coverage.shape
+    agents = poses.shape[0]
+    total_deficit = law.target_ticks * rows * cols
+    for step in range(steps):
+        windows = List()
+        for i in range(agents):
+            x, y, theta = poses[i, 0], poses[i, 1], poses[i, 2]
+            v, omega, e_omega, row0, col0, ticks = decide_and_sense(
+                coverage, x, y, theta, objectives[i, 0], objectives[i, 1], law
+            )
+            windows.append((row0, col0, ticks))
+            trace[step, i, 0] = x
+            trace[step, i, 1] = y
+            trace[step, i, 2] = theta
+            trace[step, i, 3] = v
+            trace[step, i, 4] = omega
+            trace[step, i, 5] = e_omega
+        for window in windows:
+            removed, covered = add_window(coverage, window[0], window[1], window[2], law.target_ticks)
+            deficit -= removed
+            uncovered -= covered
+        for i in range(agents):
+            poses[i, 0], poses[i, 1], poses[i, 2] = move(
+                poses[i, 0], poses[i, 1], poses[i, 2], trace[step, i, 3], trace[step, i, 4], law
+            )
+        errors[step] = deficit / total_deficit
+        if uncovered == 0:
+            return step + 1, uncovered, deficit
+    return steps, uncovered, deficit
+
+
+@dataclass
+class RunResult:
+    """Everything a run produced. ``trace`` has one row per step plus the final poses (v = ω = 0)."""
+
+    scenario: Scenario
+    completed: bool
+    completion_time: float
+    steps: int
+    trace: np.ndarray  # (steps + 1, N, 6), TRACE_FIELDS
+    errors: np.ndarray  # (steps + 1,), e_D at t_0 .. t_steps
+    snapshot_times: list[float]
+    snapshots: list[np.ndarray]  # Υ as uint8 (0 = covered, 255 = untouched)
+    final_lack: np.ndarray
+    plan_time: float | None = None  # zig-zag only: when the last lane was finished
+
+    @property
+    def path_lengths(self) -> np.ndarray:
+        """Σ |v| dt per agent."""
+        return np.abs(self.trace[:-1, :, 3]).sum(axis=0) * self.scenario.dt
+
+
+ProgressCallback = Callable[[float, float], None]
+"""Called as progress(sim_time, e_D) after each block of steps."""
+
+
+def _quantised(lack: np.ndarray) -> np.ndarray:
+    return np.round(lack * 255.0).astype(np.uint8)
+
+
+def run_scenario(
+    scenario: Scenario,
+    poses: np.ndarray | None = None,
+    record_trace: bool = True,
+    progress: ProgressCallback | None = None,
+) -> RunResult:
+    """Run one team to full coverage or ``max_time`` in this process."""
+    rows, cols = scenario.grid_shape
+    coverage_map = CoverageMap(rows, cols, scenario.cell, scenario.lambda_star)
+    poses = initial_poses(scenario) if poses is None else np.array(poses, dtype=np.float64)
+    if scenario.controller == "zigzag":
+        return _run_zigzag(scenario, coverage_map, poses, record_trace, progress)
+    law = law_parameters(scenario, coverage_map)
+    planner = Planner(scenario)
+    block = scenario.replan_steps
+    agents = scenario.agents
+    traces: list[np.ndarray] = []
+    errors: list[np.ndarray] = [np.array([coverage_map.domain_error()])]
+    snapshot_times, snapshots = [0.0], [_quantised(coverage_map.lack_of_coverage())]
+    scratch_trace = np.zeros((block, agents, len(TRACE_FIELDS)))
+    scratch_errors = np.zeros(block)
+    steps_done = 0
+    next_snapshot = SNAPSHOT_PERIOD
+    while steps_done < scenario.max_steps and not coverage_map.complete:
+        lack = coverage_map.lack_of_coverage()
+        objectives = planner.plan(lack, poses[:, :2])
+        steps = min(block, scenario.max_steps - steps_done)
+        done, coverage_map.uncovered_cells, coverage_map.deficit_ticks = advance_team(
+            coverage_map.coverage,
+            poses,
+            objectives,
+            law,
+            steps,
+            coverage_map.uncovered_cells,
+            coverage_map.deficit_ticks,
+            scratch_trace,
+            scratch_errors,
+        )
+        if record_trace:
+            traces.append(scratch_trace[:done].copy())
+        else:
+            traces.append(np.abs(scratch_trace[:done, :, 3]).sum(axis=0)[None, :, None] * np.ones((1, 1, 1)))
+        errors.append(scratch_errors[:done].copy())
+        steps_done += done
+        now = steps_done * scenario.dt
+        if now >= next_snapshot - 1e-9 or coverage_map.complete:
+            snapshot_times.append(now)
+            snapshots.append(_quantised(coverage_map.lack_of_coverage()))
+            next_snapshot += SNAPSHOT_PERIOD
+        if progress is not None:
+            progress(now, coverage_map.domain_error())
+    return _finish(scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace)
+
+
+def _finish(
+    scenario: Scenario,
+    coverage_map: CoverageMap,
+    poses: np.ndarray,
+    traces: list[np.ndarray],
+    errors: list[np.ndarray],
+    steps_done: int,
+    snapshot_times: list[float],
+    snapshots: list[np.ndarray],
+    record_trace: bool,
+    plan_time: float | None = None,
+    completion_step: int | None = None,
+) -> RunResult:
+    final_rows = np.zeros((1, scenario.agents, len(TRACE_FIELDS)))
+    final_rows[0, :, :3] = poses
+    if record_trace:
+        trace = np.concatenate([*traces, final_rows]) if traces else final_rows
+    else:
+        # Without a trace keep only |v| sums, laid out so path_lengths still works.
+        speed_sums = np.zeros((2, scenario.agents, len(TRACE_FIELDS)))
+        for chunk in traces:
+            speed_sums[0, :, 3] += chunk[0, :, 0]
+        speed_sums[1] = final_rows[0]
+        trace = speed_sums
+    completed = coverage_map.complete
+    completion_step = steps_done if completion_step is None else completion_step
+    return RunResult(
+        scenario=scenario,
+        completed=completed,
+        completion_time=completion_step * scenario.dt if completed else math.inf,
+        steps=steps_done,
+        trace=trace,
+        errors=np.concatenate(errors),
+        snapshot_times=snapshot_times,
+        snapshots=snapshots,
+        final_lack=coverage_map.lack_of_coverage(),
+        plan_time=plan_time,
+    )
+
+
+def zigzag_pilots(scenario: Scenario) -> list[WaypointPilot]:
+    """One waypoint pilot per agent, each sweeping a contiguous block of the Fig. 8 lanes."""
+    d100 = coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
+    d50 = coverage_distance(scenario.lambda_star / 2.0, scenario.range, scenario.half_angle, scenario.alpha_max)
+    lanes = lane_offsets(scenario.domain[1], d100, 2.0 * d50)
+    pilots = []
+    for first, block in split_lanes(lanes, scenario.agents):
+        waypoints = zigzag_waypoints(scenario.domain[0], block, scenario.range, first)
+        pilots.append(WaypointPilot(waypoints, scenario.k_v, scenario.k_omega * math.pi / 2.0, scenario.dt))
+    return pilots
+
+
+def zigzag_start_poses(scenario: Scenario) -> np.ndarray:
+    """Poses at the start of each agent's first lane, facing along it."""
+    poses = []
+    for pilot in zigzag_pilots(scenario):
+        (x0, y0), (x1, y1) = pilot.waypoints[0], pilot.waypoints[1]
+        poses.append((x0, y0, math.atan2(y1 - y0, x1 - x0)))
+    return np.array(poses, dtype=np.float64)
+
+
+def _run_zigzag(
+    scenario: Scenario,
+    coverage_map: CoverageMap,
+    poses: np.ndarray,
+    record_trace: bool,
+    progress: ProgressCallback | None,
+) -> RunResult:
+    """The zig-zag baseline: each agent flies its lanes; the run lasts until every plan is done."""
+    law = law_parameters(scenario, coverage_map)
+    pilots = zigzag_pilots(scenario)
+    rows_out: list[np.ndarray] = []
+    errors = [coverage_map.domain_error()]
+    snapshot_times, snapshots = [0.0], [_quantised(coverage_map.lack_of_coverage())]
+    completion_step: int | None = None
+    step = 0
+    while step < scenario.max_steps and not all(pilot.finished for pilot in pilots):
+        row = np.zeros((scenario.agents, len(TRACE_FIELDS)))
+        for i, pilot in enumerate(pilots):
+            v, omega = pilot.velocities(*poses[i])
+            row[i] = (*poses[i], v, omega, 0.0)
+        windows = [sense_only(coverage_map.coverage, *poses[i], law) for i in range(scenario.agents)]
+        for window in windows:
+            coverage_map.add(*window)
+        for i in range(scenario.agents):
+            poses[i] = move(*poses[i], row[i, 3], row[i, 4], law)
+        rows_out.append(row)
+        errors.append(coverage_map.domain_error())
+        step += 1
+        if coverage_map.complete and completion_step is None:
+            completion_step = step
+        if step % round(SNAPSHOT_PERIOD / scenario.dt) == 0:
+            snapshot_times.append(step * scenario.dt)
+            snapshots.append(_quantised(coverage_map.lack_of_coverage()))
+            if progress is not None:
+                progress(step * scenario.dt, coverage_map.domain_error())
+    plan_time = step * scenario.dt if all(pilot.finished for pilot in pilots) else None
+    trace = np.stack(rows_out) if rows_out else np.zeros((0, scenario.agents, len(TRACE_FIELDS)))
+    snapshot_times.append(step * scenario.dt)
+    snapshots.append(_quantised(coverage_map.lack_of_coverage()))
+    chunks = [trace] if record_trace else [np.abs(trace[:, :, 3]).sum(axis=0)[None, :, None]]
+    return _finish(
+        scenario,
+        coverage_map,
+        poses,
+        chunks,
+        [np.array(errors)],
+        step,
+        snapshot_times,
+        snapshots,
+        record_trace,
+        plan_time,
+        completion_step,
+    )

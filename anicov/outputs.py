@@ -1,0 +1,81 @@
+"""What a run leaves behind: trajectory.csv, summary.json and the one-screen summary.
+
+Numbers are written with Python's shortest round-trip ``repr``, so the same
+run gives byte-identical files and a reader recovers the exact floats.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from anicov.engine import RunResult
+from anicov.metrics import optimum_time, total_sensing_ability
+
+TRAJECTORY_HEADER = "t,agent,x,y,theta,v,omega"
+
+
+def step_time(step: int, dt: float) -> float:
+    """t_k = k·dt, rounded to 9 decimals so that 0.1·3 prints as 0.3."""
+    return round(step * dt, 9)
+
+
+def write_trajectory(result: RunResult, path: Path) -> None:
+    """One row per agent per step (pose at the start, (v, ω) during), then the final poses with v = ω = 0."""
+    dt = result.scenario.dt
+    lines = [TRAJECTORY_HEADER]
+    for step, rows in enumerate(result.trace):
+        t = repr(step_time(step, dt))
+        for agent, (x, y, theta, v, omega, _) in enumerate(rows.tolist()):
+            lines.append(f"{t},{agent},{x!r},{y!r},{theta!r},{v!r},{omega!r}")
+    path.write_text("\n".join(lines) + "\n", encoding="ascii")
+
+
+def summary_of(result: RunResult) -> dict[str, Any]:
+    """The summary.json fields (see README)."""
+    scenario = result.scenario
+    ability = total_sensing_ability(scenario.range, scenario.half_angle, scenario.alpha_max)
+    optimum = optimum_time(scenario.domain[0] * scenario.domain[1], scenario.lambda_star, ability, scenario.agents)
+    paths = result.path_lengths
+    completion = result.completion_time if result.completed else None
+    summary: dict[str, Any] = {
+        "scenario": scenario.to_dict(),
+        "completed": result.completed,
+        "completion_time": completion,
+        "steps": result.steps,
+        "path_length": [float(length) for length in paths],
+        "team_path_length": float(paths.sum()),
+        "final_error": float(result.errors[-1]),
+        "optimum_time": optimum,
+        "time_ratio": completion / optimum if completion is not None else None,
+    }
+    if result.plan_time is not None:
+        summary["plan_time"] = result.plan_time
+    return summary
+
+
+def write_summary(summary: dict[str, Any], path: Path) -> None:
+    path.write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+
+
+def format_summary(summary: dict[str, Any], out_dir: Path | None = None) -> str:
+    """A one-screen, human summary of a run."""
+    scenario = summary["scenario"]
+    status = "complete" if summary["completed"] else "NOT complete (max_time reached)"
+    completion = summary["completion_time"]
+    lines = [
+        f"anicov run: {scenario['agents']} agent(s), controller {scenario['controller']}, seed {scenario['seed']}",
+        f"  coverage        {status}, final e_D = {summary['final_error']:.4f}",
+        f"  completion time {completion:.1f}" if completion is not None else "  completion time -",
+        f"  optimum t*_N    {summary['optimum_time']:.1f}"
+        + (f"   (ratio {summary['time_ratio']:.2f})" if summary["time_ratio"] is not None else ""),
+        f"  steps           {summary['steps']} (dt = {scenario['dt']})",
+        f"  team path       {summary['team_path_length']:.1f}"
+        + "   per agent: "
+        + ", ".join(f"{length:.0f}" for length in summary["path_length"][:8])
+        + (" ..." if len(summary["path_length"]) > 8 else ""),
+    ]
+    if out_dir is not None:
+        lines.append(f"  outputs         {out_dir}/")
+    return "\n".join(lines)

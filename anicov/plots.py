@@ -1,0 +1,96 @@
+"""PNG figures of one run, after the paper's Fig. 4 (e_D), Fig. 5 (v, ω) and Fig. 6 (Υ maps)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from anicov.engine import RunResult
+
+
+def plot_domain_error(result: RunResult, path: Path) -> None:
+    """Fig. 4: evolution of the normalised coverage error e_D(t)."""
+    times = np.arange(len(result.errors)) * result.scenario.dt
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    ax.plot(times, result.errors, color="black")
+    ax.set_xlabel("time")
+    ax.set_ylabel("$e_D$")
+    ax.set_ylim(0.0, 1.02)
+    ax.set_title("Domain coverage error (Fig. 4)")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_velocities(result: RunResult, path: Path) -> None:
+    """Fig. 5: linear (solid) and angular (dotted) velocity of each agent."""
+    trace = result.trace[:-1]
+    times = np.arange(len(trace)) * result.scenario.dt
+    agents = min(result.scenario.agents, 8)
+    fig, axes = plt.subplots(agents, 1, figsize=(7, 1.4 * agents + 0.8), sharex=True, squeeze=False)
+    for agent in range(agents):
+        ax = axes[agent, 0]
+        ax.plot(times, trace[:, agent, 3], color="tab:blue", linewidth=0.8, label="v")
+        ax.plot(times, trace[:, agent, 4], color="tab:red", linewidth=0.8, linestyle=":", label="ω")
+        ax.set_ylabel(f"agent {agent}")
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(loc="upper right", fontsize=8)
+    axes[0, 0].set_title("Motion actions (Fig. 5)" + ("" if agents == result.scenario.agents else " — first 8 agents"))
+    axes[-1, 0].set_xlabel("time")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_coverage_maps(result: RunResult, path: Path) -> None:
+    """Fig. 6: lack of coverage Υ at four times, with the trajectories so far."""
+    scenario = result.scenario
+    width, height = scenario.domain
+    last = len(result.snapshots) - 1
+    picks = sorted({round(last * fraction) for fraction in (0.25, 0.5, 0.75, 1.0)})
+    fig, axes = plt.subplots(1, len(picks), figsize=(3.3 * len(picks), 3.6), squeeze=False)
+    for ax, pick in zip(axes[0], picks, strict=True):
+        time = result.snapshot_times[pick]
+        ax.imshow(
+            result.snapshots[pick] / 255.0,
+            origin="lower",
+            extent=(0, width, 0, height),
+            cmap="gray_r",
+            vmin=0.0,
+            vmax=1.0,
+        )
+        upto = min(round(time / scenario.dt) + 1, len(result.trace))
+        for agent in range(scenario.agents):
+            (line,) = ax.plot(result.trace[:upto, agent, 0], result.trace[:upto, agent, 1], linewidth=0.6)
+            ax.plot(
+                result.trace[upto - 1, agent, 0],
+                result.trace[upto - 1, agent, 1],
+                "o",
+                markersize=5,
+                mfc="none",
+                color=line.get_color(),
+            )
+        ax.plot([0, width, width, 0, 0], [0, 0, height, height, 0], "k--", linewidth=0.8)
+        ax.set_xlim(-0.1 * width, 1.1 * width)
+        ax.set_ylim(-0.1 * height, 1.1 * height)
+        ax.set_aspect("equal")
+        ax.set_title(f"t = {time:.0f}")
+    fig.suptitle("Lack of coverage Υ (black: uncovered) and trajectories (Fig. 6)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_run_plots(result: RunResult, out_dir: Path) -> list[Path]:
+    """All three figures of a run into ``out_dir``; returns their paths."""
+    paths = [out_dir / "error.png", out_dir / "velocities.png", out_dir / "coverage_maps.png"]
+    plot_domain_error(result, paths[0])
+    plot_velocities(result, paths[1])
+    plot_coverage_maps(result, paths[2])
+    return paths

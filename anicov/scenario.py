@@ -1,0 +1,155 @@
+"""Scenarios: the paper's setting and the user's own, read from TOML and validated.
+
+Every key is checked on load; a bad file fails at once with a message that
+names the key and what is expected. Angles are given in degrees in the file.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+from typing import Any
+
+CONTROLLERS = ("paper", "paper-literal", "zigzag")
+"""``paper``: the chosen readings of eq. 11 and 16; ``paper-literal``: both as printed; ``zigzag``: Fig. 8."""
+
+
+class ScenarioError(ValueError):
+    """A scenario file or value that cannot be used; the message names the key."""
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One coverage problem and team. Units: lengths in domain units, time in time units."""
+
+    domain: tuple[float, float] = (100.0, 100.0)
+    cell: float = 1.0
+    dt: float = 0.1
+    agents: int = 4
+    range: float = 20.0
+    half_angle_deg: float = 27.0
+    alpha_max: float = 50.0
+    lambda_star: float = 100.0
+    beta: float = 1.0
+    k_v: float = 1.0
+    k_omega: float = 1.0
+    seed: int = 0
+    max_time: float = 10000.0
+    controller: str = "paper"
+    replan_period: float = 5.0
+
+    @property
+    def half_angle(self) -> float:
+        """F in radians."""
+        return math.radians(self.half_angle_deg)
+
+    @property
+    def grid_shape(self) -> tuple[int, int]:
+        """(rows, cols) of the coverage grid."""
+        return round(self.domain[1] / self.cell), round(self.domain[0] / self.cell)
+
+    @property
+    def max_steps(self) -> int:
+        return math.ceil(self.max_time / self.dt - 1e-9)
+
+    @property
+    def replan_steps(self) -> int:
+        return max(1, round(self.replan_period / self.dt))
+
+    def to_dict(self) -> dict[str, Any]:
+        values = asdict(self)
+        values["domain"] = list(self.domain)
+        return values
+
+    def with_overrides(self, **overrides: Any) -> Scenario:
+        """A validated copy with some keys replaced (``None`` values are ignored)."""
+        given = {key: value for key, value in overrides.items() if value is not None}
+        return validate(self.to_dict() | given)
+
+
+_POSITIVE_FLOATS = (
+    "cell",
+    "dt",
+    "range",
+    "alpha_max",
+    "lambda_star",
+    "beta",
+    "k_v",
+    "k_omega",
+    "max_time",
+    "replan_period",
+)
+
+
+def _number(key: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ScenarioError(f"scenario key '{key}': expected a finite number, got {value!r}")
+    return float(value)
+
+
+def validate(values: dict[str, Any]) -> Scenario:
+    """Build a Scenario from a mapping, checking every key; raise ScenarioError naming the bad one."""
+    known = {name for name in Scenario.__dataclass_fields__}
+    unknown = sorted(set(values) - known)
+    if unknown:
+        raise ScenarioError(f"unknown scenario key '{unknown[0]}': expected one of {', '.join(sorted(known))}")
+    resolved: dict[str, Any] = {}
+    for key, value in values.items():
+        if key == "domain":
+            if not isinstance(value, list | tuple) or len(value) != 2:
+                raise ScenarioError(f"scenario key 'domain': expected [width, height], got {value!r}")
+            width, height = (_number("domain", item) for item in value)
+            if width <= 0 or height <= 0:
+                raise ScenarioError(f"scenario key 'domain': expected positive sizes, got {value!r}")
+            resolved[key] = (width, height)
+        elif key in ("agents", "seed"):
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise ScenarioError(f"scenario key '{key}': expected an integer, got {value!r}")
+            if key == "agents" and not 1 <= value <= 1000:
+                raise ScenarioError(f"scenario key 'agents': expected an integer from 1 to 1000, got {value}")
+            if key == "seed" and value < 0:
+                raise ScenarioError(f"scenario key 'seed': expected a non-negative integer, got {value}")
+            resolved[key] = value
+        elif key == "controller":
+            if value not in CONTROLLERS:
+                raise ScenarioError(
+                    f"scenario key 'controller': expected one of {', '.join(CONTROLLERS)}, got {value!r}"
+                )
+            resolved[key] = value
+        elif key == "half_angle_deg":
+            angle = _number(key, value)
+            if not 0.0 < angle < 180.0:
+                raise ScenarioError(f"scenario key 'half_angle_deg': expected a number in (0, 180), got {value!r}")
+            resolved[key] = angle
+        else:
+            number = _number(key, value)
+            if key in _POSITIVE_FLOATS and number <= 0.0:
+                raise ScenarioError(f"scenario key '{key}': expected a positive number, got {value!r}")
+            resolved[key] = number
+    scenario = replace(Scenario(), **resolved)
+    rows, cols = scenario.grid_shape
+    for axis, cells, size in (("width", cols, scenario.domain[0]), ("height", rows, scenario.domain[1])):
+        if cells < 1 or abs(cells * scenario.cell - size) > 1e-9 * size:
+            raise ScenarioError(
+                f"scenario key 'cell': expected a size that divides the domain {axis} {size}, got {scenario.cell}"
+            )
+    return scenario
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario TOML file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise ScenarioError(f"cannot read scenario file {path}: {error.strerror}") from error
+    try:
+        values = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise ScenarioError(f"scenario file {path} is not valid TOML: {error}") from error
+    try:
+        return validate(values)
+    except ScenarioError as error:
+        raise ScenarioError(f"{path}: {error}") from error

@@ -1,0 +1,112 @@
+"""Algorithm 1: global objectives from blobs of uncovered cells (Section IV).
+
+Objectives Ψ and their blobs π_j persist between calls. Each call
+
+1. drops objectives whose own cell is covered (lines 1–5) and objectives
+   whose nearest other objective is closer than R (lines 6–13), releasing
+   their cells;
+2. finds blobs (8-connected components) of uncovered, unassigned cells
+   (line 14, 16) and keeps a blob only if its centroid falls inside it
+   (line 18, read as "ψ^k ∈ π^k");
+3. erodes what is left and repeats until nothing is left (lines 15–24), so
+   irregular blobs (rings, C and L shapes, Fig. 3) shrink until their
+   centroids land on uncovered cells;
+4. gives the eroded cells to the nearest blob (line 25).
+
+If no objective survives while cells are still uncovered (a symmetric map
+that erodes away entirely), the uncovered cell nearest to the team is the
+single objective until the symmetry breaks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+_ERODE_KERNEL = np.ones((3, 3), dtype=np.uint8)
+
+
+@dataclass
+class BlobObjectives:
+    """Ψ (objective positions, world units) and the blob label of every cell (0 = none, j+1 = π_j)."""
+
+    positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    labels: np.ndarray | None = None
+
+    @property
+    def count(self) -> int:
+        return len(self.positions)
+
+
+def cell_of(point: np.ndarray, cell: float, shape: tuple[int, int]) -> tuple[int, int]:
+    """(row, col) of the grid cell containing a world point, clamped to the grid."""
+    row = min(max(int(point[1] // cell), 0), shape[0] - 1)
+    col = min(max(int(point[0] // cell), 0), shape[1] - 1)
+    return row, col
+
+
+def _keep_objectives(previous: BlobObjectives, lack: np.ndarray, cell: float, merge_distance: float) -> list[int]:
+    """Indices of previous objectives that survive lines 1–13."""
+    uncovered = [j for j, point in enumerate(previous.positions) if lack[cell_of(point, cell, lack.shape)] > 0.0]
+    if len(uncovered) < 2:
+        return uncovered
+    points = previous.positions[uncovered]
+    gaps = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2)
+    np.fill_diagonal(gaps, np.inf)
+    nearest = gaps.min(axis=1)
+    return [j for j, gap in zip(uncovered, nearest, strict=True) if gap >= merge_distance]
+
+
+def select_objectives(
+    lack: np.ndarray,
+    previous: BlobObjectives,
+    cell: float,
+    merge_distance: float,
+) -> BlobObjectives:
+    """Algorithm 1 on the lack-of-coverage map Υ; ``merge_distance`` is R."""
+    kept = _keep_objectives(previous, lack, cell, merge_distance) if previous.count else []
+    labels = np.zeros(lack.shape, dtype=np.int32)
+    positions: list[np.ndarray] = []
+    if kept and previous.labels is not None:
+        relabel = np.zeros(previous.count + 1, dtype=np.int32)
+        for new_index, j in enumerate(kept):
+            relabel[j + 1] = new_index + 1
+            positions.append(previous.positions[j])
+        labels = relabel[previous.labels]
+
+    uncovered = lack > 0.0
+    blob_domain = (uncovered & (labels == 0)).astype(np.uint8)
+    while blob_domain.any():
+        count, components, stats, centroids = cv2.connectedComponentsWithStats(blob_domain, connectivity=8)
+        for k in range(1, count):
+            cx, cy = centroids[k]
+            row, col = round(cy), round(cx)
+            if components[row, col] != k:
+                continue
+            left, top, width, height = stats[k, :4]
+            window = components[top : top + height, left : left + width] == k
+            label = len(positions) + 1
+            labels[top : top + height, left : left + width][window] = label
+            blob_domain[top : top + height, left : left + width][window] = 0
+            positions.append(np.array([(cx + 0.5) * cell, (cy + 0.5) * cell]))
+        blob_domain = cv2.erode(blob_domain, _ERODE_KERNEL)
+
+    eroded = uncovered & (labels == 0)
+    if positions and eroded.any():
+        _, nearest = ndimage.distance_transform_edt(labels == 0, return_indices=True)
+        labels[eroded] = labels[nearest[0][eroded], nearest[1][eroded]]
+    stacked = np.array(positions, dtype=np.float64).reshape(-1, 2)
+    return BlobObjectives(positions=stacked, labels=labels)
+
+
+def fallback_objective(lack: np.ndarray, agent_positions: np.ndarray, cell: float) -> np.ndarray | None:
+    """The uncovered cell centre nearest to any agent, or None if all is covered."""
+    rows, cols = np.nonzero(lack > 0.0)
+    if rows.size == 0:
+        return None
+    centres = np.stack([(cols + 0.5) * cell, (rows + 0.5) * cell], axis=1)
+    gaps = np.linalg.norm(centres[:, None, :] - agent_positions[None, :, :], axis=2).min(axis=1)
+    return centres[int(np.argmin(gaps))]

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# One entry point for a fresh clone: every command first makes sure .venv exists and is current.
+#   ./go team [ARGS]       a 4-agent team over Zenoh, as separate processes (launch_team.py)
+#   ./go test [ARGS]       the test suite (what CI runs)
+#   ./go run ARGS          anicov run ... (one team in process)
+#   ./go reproduce ARGS    anicov reproduce ... (the paper's experiments)
+#   ./go bench             the benchmarks in bench/
+#   ./go setup             only create or update .venv
+set -euo pipefail
+cd "$(dirname "$0")"
+VENV=.venv
+PY=${PYTHON:-python3}
+
+setup() {
+    local stamp="$VENV/.installed-from"
+    local want
+    want=$(sha256sum pyproject.toml | cut -d' ' -f1)
+    if [[ ! -x "$VENV/bin/python" ]]; then
+        echo "go: creating $VENV" >&2
+        "$PY" -m venv "$VENV"
+    fi
+    if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$want" ]]; then
+        echo "go: installing anicov and its dependencies into $VENV" >&2
+        "$VENV/bin/python" -m pip install --quiet --upgrade pip >&2
+        "$VENV/bin/python" -m pip install --quiet -e '.[test]' >&2
+        echo "$want" > "$stamp"
+    fi
+}
+
+command=${1:-help}
+shift || true
+case "$command" in
+    setup) setup ;;
+    test)
+        setup
+        "$VENV/bin/ruff" check .
+        exec "$VENV/bin/python" -m pytest "$@"
+        ;;
+    team) setup; exec "$VENV/bin/python" launch_team.py --n 4 "$@" ;;
+    run) setup; exec "$VENV/bin/anicov" run "$@" ;;
+    reproduce) setup; exec "$VENV/bin/anicov" reproduce "$@" ;;
+    bench) setup; exec "$VENV/bin/python" bench/run_all.py "$@" ;;
+    *) sed -n '2,9p' "$0"; exit 2 ;;
+esac

@@ -1,0 +1,65 @@
+import math
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from agents.control import combined_law, global_law, local_law
+
+F = math.radians(27.0)
+unit = st.floats(0.0, 1.0)
+angle = st.floats(-math.pi, math.pi)
+
+
+def test_local_law_speed_is_one_minus_error():
+    assert local_law(0.25, 1.0, 1.0, 0.3, F)[0] == 0.75
+
+
+def test_local_heading_turns_toward_uncovered_side():
+    assert local_law(0.5, 2.0, 0.0, 0.0, F)[1] == pytest.approx(F)  # all uncovered on the left
+    assert local_law(0.5, 0.0, 2.0, 0.0, F)[1] == pytest.approx(-F)
+    assert local_law(0.5, 1.0, 1.0, 0.4, F)[1] == pytest.approx(0.4)  # balanced: eq. 9 is zero
+    assert local_law(0.0, 0.0, 0.0, 0.4, F)[1] == 0.4  # nothing uncovered in view
+
+
+def test_global_law_speed_eq10_and_heading_toward_objective():
+    u, heading = global_law(0.0, 0.0, 10.0, 0.0, 20.0, False)
+    assert u == 0.0  # at R/2 from the objective
+    assert heading == 0.0
+    u_far, heading_up = global_law(0.0, 0.0, 0.0, 500.0, 20.0, False)
+    assert u_far == pytest.approx((2 / math.pi) * math.atan(490.0))
+    assert heading_up == pytest.approx(math.pi / 2)
+    assert global_law(0.0, 0.0, 3.0, 0.0, 20.0, False)[0] < 0.0  # too close: back off
+
+
+def test_literal_eq11_points_away_from_objective():
+    _, heading = global_law(0.0, 0.0, 0.0, 50.0, 20.0, True)
+    assert heading == pytest.approx(-math.pi / 2)
+
+
+@given(
+    angle, unit, unit, angle, st.floats(-1.0, 1.0), angle, st.floats(0.1, 5.0), st.floats(0.1, 3.0), st.floats(0.1, 3.0)
+)
+def test_velocities_stay_in_stated_bounds(theta, e_omega, u_loc, theta_loc, u_glo, theta_glo, beta, k_v, k_omega):
+    """eq. 15–16 (chosen reading): v ∈ [−k_v, k_v], ω ∈ [−k_ω π, k_ω π] for any input."""
+    v, omega = combined_law(theta, e_omega, u_loc, theta_loc, u_glo, theta_glo, beta, k_v, k_omega, False)
+    assert abs(v) <= k_v + 1e-12
+    assert abs(omega) <= k_omega * math.pi + 1e-12
+
+
+def test_literal_eq16_can_exceed_the_stated_bound():
+    # u_glo → −1 (right on the objective) doubles the turn rate: the paper's bound fails as printed.
+    _, omega = combined_law(0.0, 0.0, 0.0, 0.0, -0.99, math.pi - 0.01, 1.0, 1.0, 1.0, True)
+    assert abs(omega) > math.pi
+
+
+def test_full_local_error_stops_the_agent():
+    # e_Ω = 1: W_loc = 1, u_loc = 0 → v = 0, the agent covers where it stands.
+    v, _ = combined_law(0.0, 1.0, 0.0, 0.2, 1.0, 2.0, 1.0, 1.0, 1.0, False)
+    assert v == 0.0
+
+
+def test_no_local_error_follows_global_law():
+    v, omega = combined_law(0.0, 0.0, 1.0, 0.0, 0.8, 0.5, 1.0, 1.0, 1.0, False)
+    assert omega == pytest.approx(0.5)
+    assert v == pytest.approx(0.8 * (1 - (2 / math.pi) * 0.5))

@@ -1,0 +1,89 @@
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from agents.sensing import lack_of_coverage, sense_wedge, sensing_ability
+from anicov.metrics import total_sensing_ability
+from protocol.fixed_point import COVERAGE_SCALE
+
+R, F, ALPHA = 20.0, math.radians(27.0), 50.0
+TARGET = 100 * COVERAGE_SCALE
+
+
+def test_sensing_ability_is_maximal_at_apex_and_zero_on_the_border():
+    assert sensing_ability(0.0, 0.0, R, F, ALPHA) == ALPHA
+    assert sensing_ability(R, 0.0, R, F, ALPHA) == 0.0
+    assert sensing_ability(0.0, F, R, F, ALPHA) == 0.0
+    assert sensing_ability(R + 0.1, 0.0, R, F, ALPHA) == 0.0
+    assert sensing_ability(1.0, F + 0.01, R, F, ALPHA) == 0.0
+
+
+@given(st.floats(0.0, 30.0), st.floats(0.0, math.pi))
+def test_sensing_ability_matches_eq2_and_is_bounded(r, offset):
+    value = sensing_ability(r, offset, R, F, ALPHA)
+    assert 0.0 <= value <= ALPHA
+    if r <= R and offset <= F:
+        assert value == pytest.approx(ALPHA * (R - r) * (F - offset) / (R * F))
+    else:
+        assert value == 0.0
+
+
+def test_lack_of_coverage_eq4():
+    assert lack_of_coverage(0, TARGET) == 1.0
+    assert lack_of_coverage(TARGET // 4, TARGET) == 0.75
+    assert lack_of_coverage(TARGET, TARGET) == 0.0
+    assert lack_of_coverage(3 * TARGET, TARGET) == 0.0
+
+
+@pytest.mark.parametrize("cell", [1.0, 0.5, 0.25])
+@pytest.mark.parametrize("theta", [0.0, 0.7, -2.5])
+def test_delta_integrates_to_total_ability_times_dt(cell, theta):
+    """Σ cells of α·dt over the wedge → 𝒜·dt (eq. 18) as the grid is refined."""
+    cells = int(100 / cell)
+    coverage = np.zeros((cells, cells), dtype=np.int64)
+    dt = 0.1
+    *_, ticks = sense_wedge(coverage, TARGET, 50.0, 50.0, theta, R, F, ALPHA, dt, cell)
+    integral = ticks.sum() / COVERAGE_SCALE * cell * cell
+    exact = total_sensing_ability(R, F, ALPHA) * dt
+    assert integral == pytest.approx(exact, rel=0.02 if cell == 1.0 else 0.006)
+
+
+def test_fresh_map_reads_full_error_and_balanced_gradient_when_heading_along_axis():
+    coverage = np.zeros((100, 100), dtype=np.int64)
+    e_omega, w_left, w_right, *_ = sense_wedge(coverage, TARGET, 50.5, 50.5, 0.0, R, F, ALPHA, 0.1, 1.0)
+    assert e_omega == 1.0
+    assert w_left == pytest.approx(w_right)
+    assert w_left > 0.0
+
+
+def test_covered_left_half_pulls_gradient_right():
+    coverage = np.zeros((100, 100), dtype=np.int64)
+    coverage[51:, :] = TARGET  # rows above the agent (left when heading +x) are covered
+    e_omega, w_left, w_right, *_ = sense_wedge(coverage, TARGET, 50.5, 50.5, 0.0, R, F, ALPHA, 0.1, 1.0)
+    assert w_left == 0.0 and w_right > 0.0
+    assert 0.4 < e_omega < 0.6
+
+
+def test_wedge_outside_domain_counts_area_but_no_error():
+    coverage = np.zeros((100, 100), dtype=np.int64)
+    e_omega, w_left, w_right, _row0, _col0, ticks = sense_wedge(
+        coverage, TARGET, 100.0, 50.5, 0.0, R, F, ALPHA, 0.1, 1.0
+    )
+    assert e_omega == 0.0 and w_left == 0.0 and w_right == 0.0
+    assert ticks.size == 0 or ticks.sum() == 0
+
+
+@settings(max_examples=60)
+@given(st.floats(-30.0, 130.0), st.floats(-30.0, 130.0), st.floats(-math.pi, math.pi))
+def test_delta_window_lies_inside_grid_and_is_non_negative(x, y, theta):
+    coverage = np.zeros((100, 100), dtype=np.int64)
+    e_omega, w_left, w_right, row0, col0, ticks = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0)
+    assert 0.0 <= e_omega <= 1.0
+    assert w_left >= 0.0 and w_right >= 0.0
+    assert (ticks >= 0).all()
+    if ticks.size:
+        assert row0 >= 0 and col0 >= 0
+        assert row0 + ticks.shape[0] <= 100 and col0 + ticks.shape[1] <= 100
