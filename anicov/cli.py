@@ -56,6 +56,77 @@ def command_reproduce(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _process_scenario(args: argparse.Namespace) -> Scenario:
+    scenario = resolve_scenario(args)
+    if args.speed <= 0:
+        raise ScenarioError(f"--speed: expected a positive number, got {args.speed}")
+    return scenario
+
+
+def command_agent(args: argparse.Namespace) -> int:
+    from agents.process import AgentOptions, run_agent
+    from anicov.lifecycle import StopFlag, setup_logging
+    from protocol.bus import zenoh_config
+
+    setup_logging(f"agent-{args.id}", args.verbose)
+    stop = StopFlag().install()
+    scenario = _process_scenario(args)
+    if not 0 <= args.id < scenario.agents:
+        raise ScenarioError(f"--id: expected an agent id from 0 to {scenario.agents - 1}, got {args.id}")
+    options = AgentOptions(args.team, args.id, args.clock, args.speed, args.drop_rate, args.counts)
+    config = zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
+    return run_agent(scenario, options, config, stop)
+
+
+def command_coordinator(args: argparse.Namespace) -> int:
+    from anicov.lifecycle import StopFlag, setup_logging
+    from coordinator.process import CoordinatorOptions, run_coordinator
+    from protocol.bus import zenoh_config
+
+    setup_logging("coordinator", args.verbose)
+    stop = StopFlag().install()
+    scenario = _process_scenario(args)
+    options = CoordinatorOptions(args.team, args.clock, args.speed, args.out, args.drop_rate)
+    config = zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
+    return run_coordinator(scenario, options, config, stop)
+
+
+def command_router(args: argparse.Namespace) -> int:
+    import zenoh
+
+    from anicov.lifecycle import StopFlag, setup_logging
+    from protocol.bus import zenoh_config
+
+    setup_logging("router")
+    stop = StopFlag().install()
+    config = zenoh_config("router", listen=args.listen, config_file=args.zenoh_config)
+    with zenoh.open(config):
+        print(f"anicov router listening on {', '.join(args.listen or ['(config file)'])}; Ctrl-C stops it", flush=True)
+        stop.event.wait()
+    return stop.exit_code(EXIT_OK)
+
+
+def command_launch(args: argparse.Namespace) -> int:
+    from anicov.launch import main as launch_main
+
+    return launch_main(args.rest)
+
+
+def _add_process_arguments(parser: argparse.ArgumentParser) -> None:
+    from anicov.launch import add_team_arguments
+
+    add_team_arguments(parser)
+    parser.add_argument("--team", default="team", help="team name: keys live under anicov/<team>/")
+    parser.add_argument(
+        "--connect", action="append", help="Zenoh endpoint to connect to (repeatable), e.g. tcp/192.168.1.10:7447"
+    )
+    parser.add_argument("--listen", action="append", help="Zenoh endpoint to listen on (peer mode)")
+    parser.add_argument("--mode", choices=("client", "peer"), default="client", help="Zenoh mode (default client)")
+    parser.add_argument("--zenoh-config", help="a Zenoh JSON5 config file (see deploy/); flags add endpoints")
+    parser.add_argument("--drop-rate", type=float, default=0.0, help=argparse.SUPPRESS)  # test hook
+    parser.add_argument("--verbose", action="store_true", help="debug logging")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="anicov", description=__doc__)
     commands = parser.add_subparsers(dest="command", required=True)
@@ -76,6 +147,26 @@ def build_parser() -> argparse.ArgumentParser:
     reproduce.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
     reproduce.add_argument("--seed", type=int, default=0, help="base seed; run r of every team uses seed+r")
     reproduce.set_defaults(handler=command_reproduce)
+
+    agent = commands.add_parser("agent", help="one robot of a team, on the Zenoh bus")
+    agent.add_argument("--id", type=int, required=True, help="this agent's id, 0..N-1")
+    agent.add_argument("--counts", help="write message counters to this JSON file at exit")
+    _add_process_arguments(agent)
+    agent.set_defaults(handler=command_agent)
+
+    coordinator = commands.add_parser("coordinator", help="the team's coordinator (Algorithms 1-2), on the bus")
+    coordinator.add_argument("--out", help="write the run directory here at the end")
+    _add_process_arguments(coordinator)
+    coordinator.set_defaults(handler=command_coordinator)
+
+    router = commands.add_parser("router", help="a standalone Zenoh router for a team spread over hosts")
+    router.add_argument("--listen", action="append", help="endpoint (repeatable), e.g. tcp/0.0.0.0:7447")
+    router.add_argument("--zenoh-config", help="a Zenoh JSON5 config file (see deploy/router.json5)")
+    router.set_defaults(handler=command_router)
+
+    launch = commands.add_parser("launch", help="a whole team on this machine (same as launch_team.py)", add_help=False)
+    launch.add_argument("rest", nargs=argparse.REMAINDER)
+    launch.set_defaults(handler=command_launch)
     return parser
 
 
@@ -84,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.handler(args))
-    except ScenarioError as error:
+    except (ScenarioError, ValueError) as error:
         print(f"anicov: error: {error}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:

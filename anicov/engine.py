@@ -147,8 +147,8 @@ class RunResult:
 
     @property
     def path_lengths(self) -> np.ndarray:
-        """Σ |v| dt per agent."""
-        return np.abs(self.trace[:-1, :, 3]).sum(axis=0) * self.scenario.dt
+        """Σ |v| dt per agent (steps whose state was never heard, NaN in a realtime trace, count as 0)."""
+        return np.nansum(np.abs(self.trace[:-1, :, 3]), axis=0) * self.scenario.dt
 
 
 ProgressCallback = Callable[[float, float], None]

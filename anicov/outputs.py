@@ -28,6 +28,8 @@ def write_trajectory(result: RunResult, path: Path) -> None:
     for step, rows in enumerate(result.trace):
         t = repr(step_time(step, dt))
         for agent, (x, y, theta, v, omega, _) in enumerate(rows.tolist()):
+            if x != x:  # NaN: a realtime run that never heard this agent's state for this step
+                continue
             lines.append(f"{t},{agent},{x!r},{y!r},{theta!r},{v!r},{omega!r}")
     path.write_text("\n".join(lines) + "\n", encoding="ascii")
 

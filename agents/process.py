@@ -1,0 +1,232 @@
+"""The agent process: one robot of the team, on the bus.
+
+It keeps its own replica of the coverage map, decides (v, ω) with the same
+functions as the in-process engine (:mod:`agents.step`), commands its robot,
+and publishes its coverage delta and its state every step. It applies its
+teammates' deltas and follows the coordinator's objectives.
+
+Clocks:
+
+- ``lockstep``: step k starts when the coordinator's go for step k has
+  arrived and every member's step k−1 delta is in the replica; teammates'
+  deltas of step k or later are held back until this agent has done step k.
+  The result equals the in-process engine bit for bit.
+- ``realtime``: one step every dt/speed seconds of wall-clock time, with
+  whatever has arrived by then; never waits for anyone.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from dataclasses import dataclass
+
+import zenoh
+
+from agents.robot import Robot, SimulatedUnicycle
+from agents.step import LawParameters, decide_and_sense
+from anicov.engine import initial_poses, law_parameters
+from anicov.lifecycle import EXIT_FAILED, EXIT_OK, StopFlag, parent_is_gone
+from anicov.scenario import Scenario
+from protocol.bus import Inbox, Membership, Received, write_counts
+from protocol.keys import TeamKeys
+from protocol.messages import (
+    AgentState,
+    Limits,
+    MapDelta,
+    Objectives,
+    ProtocolError,
+    RunControl,
+    Snapshot,
+    decode,
+    encode,
+)
+from protocol.replica import MapReplica
+
+log = logging.getLogger("anicov.agent")
+
+HELLO_PERIOD = 0.2
+"""Seconds between repeated hellos until the coordinator's first go arrives."""
+
+
+@dataclass
+class AgentOptions:
+    team: str
+    agent: int
+    clock: str = "lockstep"
+    speed: float = 1.0
+    drop_rate: float = 0.0
+    counts_file: str | None = None
+
+
+class AgentNode:
+    """The state of one agent process between messages."""
+
+    def __init__(self, scenario: Scenario, options: AgentOptions, robot: Robot | None = None) -> None:
+        self.scenario = scenario
+        self.options = options
+        self.keys = TeamKeys(options.team)
+        rows, cols = scenario.grid_shape
+        self.limits = Limits(rows, cols, scenario.agents)
+        self.replica = MapReplica(rows, cols, scenario.cell, scenario.lambda_star)
+        self.law: LawParameters = law_parameters(scenario, self.replica.map)
+        self.robot = robot or SimulatedUnicycle(tuple(initial_poses(scenario)[options.agent]), self.law)
+        self.inbox = Inbox(self.limits, options.drop_rate, seed=1000 + options.agent)
+        self.step = 0
+        self.objective: tuple[float, float] | None = None
+        self.go: Objectives | None = None
+        self.held_back: list[MapDelta] = []
+        self.finished: RunControl | None = None
+        self.bytes_sent = 0
+
+    # ------------------------------------------------------------ messages
+
+    def handle(self, item: Received | Membership, hold_back: bool) -> None:
+        if isinstance(item, Membership):
+            return
+        message = item.message
+        if isinstance(message, MapDelta):
+            if message.agent == self.options.agent:
+                return  # our own echo: applied when it was made
+            if hold_back and message.seq >= self.step:
+                self.held_back.append(message)
+            else:
+                self.replica.apply(message)
+        elif isinstance(message, Objectives):
+            if not hold_back or message.step == self.step:
+                self.go = message
+                target = message.target_of(self.options.agent)
+                if target is not None:
+                    self.objective = target
+        elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
+            self.finished = message
+
+    def release_held_back(self) -> None:
+        """Deltas of steps before the next one may now enter the replica."""
+        keep = []
+        for delta in self.held_back:
+            if delta.seq < self.step:
+                self.replica.apply(delta)
+            else:
+                keep.append(delta)
+        self.held_back = keep
+
+    def ready_for_step(self) -> bool:
+        """Lockstep: the go for this step is here and so is every member's previous delta."""
+        if self.go is None or self.go.step != self.step or self.objective is None:
+            return False
+        if self.step == 0:
+            return True
+        return all(
+            self.replica.has(member, self.step - 1) for member in self.go.members if member != self.options.agent
+        )
+
+    # ------------------------------------------------------------ control
+
+    def control_step(self) -> tuple[MapDelta, AgentState]:
+        """Decide, sense and move for the current step (eq. 1–16); return what to publish."""
+        assert self.objective is not None
+        pose = self.robot.pose()
+        v, omega, e_omega, row0, col0, ticks = decide_and_sense(
+            self.replica.map.coverage, *pose, self.objective[0], self.objective[1], self.law
+        )
+        delta = MapDelta(self.options.agent, self.step, row0, col0, ticks)
+        self.replica.apply(delta)
+        next_pose = self.robot.command(v, omega)
+        state = AgentState(self.options.agent, self.step, pose, v, omega, e_omega, next_pose)
+        self.step += 1
+        return delta, state
+
+    def hello(self) -> AgentState:
+        pose = self.robot.pose()
+        return AgentState(self.options.agent, -1, pose, 0.0, 0.0, 0.0, pose)
+
+    def load_snapshot(self, session: zenoh.Session) -> bool:
+        """Catch up from the coordinator's snapshot, if one is served."""
+        try:
+            for reply in session.get(self.keys.snapshot, timeout=1.0):
+                if reply.ok is None:
+                    continue
+                snapshot = decode(reply.ok.payload.to_bytes(), self.limits, expected="snapshot")
+                assert isinstance(snapshot, Snapshot)
+                self.replica.load(snapshot)
+                own = snapshot.applied.get(self.options.agent)
+                if own is not None:
+                    self.step = own[0] + 1
+                return True
+        except ProtocolError as error:
+            log.warning("snapshot rejected: %s", error)
+        return False
+
+
+def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, stop: StopFlag) -> int:
+    node = AgentNode(scenario, options)
+    parent = os.getppid()
+    keys = node.keys
+    with zenoh.open(config) as session:
+        session.declare_subscriber(keys.all_deltas, node.inbox.on_sample)
+        session.declare_subscriber(keys.objectives, node.inbox.on_sample)
+        session.declare_subscriber(keys.control, node.inbox.on_sample)
+        delta_publisher = session.declare_publisher(keys.agent_delta(options.agent))
+        state_publisher = session.declare_publisher(keys.agent_state(options.agent))
+        token = session.liveliness().declare_token(keys.alive("agent", options.agent))
+
+        def publish(delta: MapDelta, state: AgentState) -> None:
+            delta_bytes, state_bytes = encode(delta), encode(state)
+            node.bytes_sent += len(delta_bytes) + len(state_bytes)
+            delta_publisher.put(delta_bytes)
+            state_publisher.put(state_bytes)
+
+        lockstep = options.clock == "lockstep"
+        # Wait for the first go, saying hello until the coordinator has heard it.
+        next_hello = 0.0
+        while node.go is None and node.finished is None and not stop.stopped:
+            if time.monotonic() >= next_hello:
+                state_publisher.put(encode(node.hello()))
+                next_hello = time.monotonic() + HELLO_PERIOD
+            item = node.inbox.get(timeout=0.05)
+            if item is not None:
+                node.handle(item, hold_back=lockstep)
+            if parent_is_gone(parent):
+                break
+        log.info("agent %d starts (%s clock)", options.agent, options.clock)
+        period = scenario.dt / options.speed
+        started = time.monotonic()
+        first_step = node.step
+        while node.finished is None and not stop.stopped and not parent_is_gone(parent):
+            if lockstep:
+                while not node.ready_for_step() and node.finished is None and not stop.stopped:
+                    item = node.inbox.get(timeout=0.5)
+                    if item is not None:
+                        node.handle(item, hold_back=True)
+                if node.finished is not None or stop.stopped:
+                    break
+                publish(*node.control_step())
+                node.release_held_back()
+            else:
+                while (item := node.inbox.get(timeout=0)) is not None:
+                    node.handle(item, hold_back=False)
+                if node.finished is not None:
+                    break
+                publish(*node.control_step())
+                wait = started + (node.step - first_step) * period - time.monotonic()
+                if wait > 0:
+                    stop.event.wait(wait)
+        token.undeclare()
+    counts = node.inbox.counts() | {
+        "steps": node.step,
+        "bytes_sent": node.bytes_sent,
+        "duplicates": node.replica.duplicates,
+    }
+    write_counts(_path(options.counts_file), counts)
+    if node.finished is not None:
+        log.info("agent %d: run %s at step %d", options.agent, node.finished.kind, node.finished.step)
+        return EXIT_OK if node.finished.kind == "done" else EXIT_FAILED
+    return stop.exit_code(EXIT_OK)
+
+
+def _path(name: str | None):
+    from pathlib import Path
+
+    return Path(name) if name else None

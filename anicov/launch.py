@@ -1,0 +1,245 @@
+"""``launch_team.py`` / ``anicov launch``: a whole team on this machine, one OS process per role.
+
+Opens an embedded Zenoh router on ``--listen``, starts the coordinator, N
+agents (and the logger, when recording) as child processes connected to it,
+shows progress, prints the run's summary and exits 0 when coverage is
+complete. Ctrl-C or SIGTERM stops every child (SIGTERM, then SIGKILL after a
+grace period), closes the router and exits 130 / 143. Children also die with
+the launcher if it is killed outright (Linux parent-death signal).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+
+from anicov.lifecycle import (
+    EXIT_FAILED,
+    EXIT_INCOMPLETE,
+    EXIT_OK,
+    EXIT_USAGE,
+    StopFlag,
+    setup_logging,
+)
+from anicov.scenario import CONTROLLERS, ScenarioError
+
+log = logging.getLogger("anicov.launch")
+
+GRACE_SECONDS = 10.0
+"""How long children get to exit after SIGTERM before SIGKILL."""
+
+
+@dataclass
+class Child:
+    role: str
+    process: subprocess.Popen[bytes]
+    log_path: Path
+
+
+def add_team_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--n", type=int, help="team size (overrides 'agents'; default 4 for launch)")
+    parser.add_argument("--config", help="scenario TOML (default: scenarios/paper.toml)")
+    parser.add_argument("--seed", type=int, help="seed of the initial poses")
+    parser.add_argument("--controller", choices=[c for c in CONTROLLERS if c != "zigzag"], help="control law")
+    parser.add_argument(
+        "--clock",
+        choices=("lockstep", "realtime"),
+        default="lockstep",
+        help="lockstep: deterministic, equal to 'anicov run'; realtime: wall-clock steps",
+    )
+    parser.add_argument(
+        "--speed",
+        type=float,
+        default=10.0,
+        help="realtime only: simulated time units per wall-clock second (default 10)",
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="launch_team.py", description=__doc__.split("\n\n")[0])
+    add_team_arguments(parser)
+    parser.add_argument("--listen", default="tcp/127.0.0.1:7447", help="router endpoint (default tcp/127.0.0.1:7447)")
+    parser.add_argument("--team", default="team", help="team name: keys live under anicov/<team>/")
+    parser.add_argument("--out", help="run directory (default runs/<date-time>)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    return parser
+
+
+def child_command(role: str, args: argparse.Namespace, extra: list[str]) -> list[str]:
+    command = [
+        sys.executable,
+        "-m",
+        "anicov.cli",
+        role,
+        "--team",
+        args.team,
+        "--connect",
+        args.listen,
+        "--clock",
+        args.clock,
+        "--speed",
+        str(args.speed),
+    ]
+    for flag, value in (
+        ("--config", args.config),
+        ("--n", args.n),
+        ("--seed", args.seed),
+        ("--controller", args.controller),
+    ):
+        if value is not None:
+            command += [flag, str(value)]
+    return command + extra
+
+
+def spawn(role: str, command: list[str], logs: Path) -> Child:
+    from anicov.lifecycle import die_with_parent
+
+    log_path = logs / f"{role}.log"
+    with open(log_path, "wb") as sink:
+        # A new session: a Ctrl-C in the terminal reaches the launcher only, which then stops
+        # the children in order, so none is cut off in the middle of writing its outputs.
+        process = subprocess.Popen(
+            command,
+            stdout=sink,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+            preexec_fn=die_with_parent,
+        )
+    return Child(role, process, log_path)
+
+
+def stop_children(children: list[Child], grace: float = GRACE_SECONDS) -> None:
+    for child in children:
+        if child.process.poll() is None:
+            child.process.terminate()
+    deadline = time.monotonic() + grace
+    for child in children:
+        try:
+            child.process.wait(timeout=max(0.1, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            log.warning("%s did not stop in %.0f s; killing it", child.role, grace)
+            child.process.kill()
+            child.process.wait()
+
+
+def warm_numba_cache() -> None:
+    """Compile (or load) the jitted kernels once here, so N children do not all compile at once."""
+    import numpy as np
+
+    from agents.step import decide_and_sense, move
+    from anicov.engine import law_parameters
+    from anicov.scenario import Scenario
+    from protocol.coverage_map import CoverageMap, add_window
+
+    scenario = Scenario()
+    grid = CoverageMap(*scenario.grid_shape, scenario.cell, scenario.lambda_star)
+    law = law_parameters(scenario, grid)
+    *_, row0, col0, ticks = decide_and_sense(grid.coverage, 50.0, 50.0, 0.0, 10.0, 10.0, law)
+    add_window(grid.coverage, row0, col0, ticks, law.target_ticks)
+    move(0.0, 0.0, 0.0, 1.0, 0.0, law)
+    np.zeros(1)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    setup_logging("launch")
+    stop = StopFlag().install()
+    if args.n is None:
+        args.n = 4
+    from anicov.cli import resolve_scenario
+
+    try:
+        scenario = resolve_scenario(args)
+        if args.speed <= 0:
+            raise ScenarioError(f"--speed: expected a positive number, got {args.speed}")
+    except ScenarioError as error:
+        print(f"launch_team: error: {error}", file=sys.stderr)
+        return EXIT_USAGE
+    out_dir = Path(args.out or Path("runs") / datetime.now().strftime("%Y%m%d-%H%M%S"))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    logs = out_dir / "logs"
+    logs.mkdir(exist_ok=True)
+    warm_numba_cache()
+
+    import zenoh
+    from tqdm import tqdm
+
+    from protocol.bus import zenoh_config
+    from protocol.keys import TeamKeys
+    from protocol.messages import Limits, ProtocolError, RunControl, decode
+
+    keys = TeamKeys(args.team)
+    limits = Limits(*scenario.grid_shape, scenario.agents)
+    latest: dict[str, RunControl] = {}
+
+    def on_control(sample: zenoh.Sample) -> None:
+        try:
+            message = decode(sample.payload.to_bytes(), limits, expected="control")
+        except ProtocolError:
+            return
+        assert isinstance(message, RunControl)
+        latest["done" if message.kind in ("done", "abort") else "status"] = message
+
+    started = time.monotonic()
+    children: list[Child] = []
+    exit_code = EXIT_FAILED
+    try:
+        router = zenoh.open(zenoh_config("router", listen=[args.listen]))
+    except zenoh.ZError as error:
+        print(f"launch_team: error: cannot open the router on {args.listen}: {error}", file=sys.stderr)
+        return EXIT_USAGE
+    with router:
+        router.declare_subscriber(keys.control, on_control)
+        router.declare_subscriber(keys.status, on_control)
+        children.append(spawn("coordinator", child_command("coordinator", args, ["--out", str(out_dir)]), logs))
+        for agent in range(scenario.agents):
+            children.append(spawn(f"agent-{agent}", child_command("agent", args, ["--id", str(agent)]), logs))
+        bar = tqdm(total=100, desc=f"team of {scenario.agents}", unit="%", disable=args.quiet or None)
+        coordinator = children[0]
+        try:
+            while not stop.stopped:
+                status = latest.get("status")
+                if status is not None:
+                    bar.set_postfix_str(f"t={status.step * scenario.dt:.0f}", refresh=False)
+                    bar.update(max(0, round(100 * (1 - status.domain_error)) - bar.n))
+                code = coordinator.process.poll()
+                if code is not None:
+                    exit_code = code
+                    break
+                failed = [c for c in children[1:] if c.process.poll() not in (None, 0)]
+                if failed and "done" not in latest:
+                    log.error(
+                        "%s exited with %s; see %s", failed[0].role, failed[0].process.returncode, failed[0].log_path
+                    )
+                    exit_code = EXIT_FAILED
+                    break
+                stop.event.wait(0.1)
+        finally:
+            bar.close()
+            stop_children(children)
+    if stop.stopped:
+        print(f"launch_team: stopped by signal; every child stopped. Logs in {logs}", file=sys.stderr)
+        return stop.exit_code(EXIT_FAILED)
+    summary_path = out_dir / "summary.json"
+    if exit_code in (EXIT_OK, EXIT_INCOMPLETE) and summary_path.exists():
+        from anicov.outputs import format_summary
+
+        summary = json.loads(summary_path.read_text())
+        print(format_summary(summary, out_dir).replace("anicov run:", f"launch_team ({args.clock}, over Zenoh):"))
+        print(f"  processes       coordinator + {scenario.agents} agents, logs in {logs}")
+        print(f"  wall time       {time.monotonic() - started:.1f} s")
+        return EXIT_OK if summary["completed"] else EXIT_INCOMPLETE
+    print(f"launch_team: the run failed (exit {exit_code}); logs in {logs}", file=sys.stderr)
+    for child in children:
+        tail = child.log_path.read_text(errors="replace").strip().splitlines()[-3:]
+        if child.process.returncode not in (0, None) and tail:
+            print(f"  {child.role} (exit {child.process.returncode}): " + " | ".join(tail), file=sys.stderr)
+    return EXIT_FAILED

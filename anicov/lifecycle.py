@@ -1,0 +1,72 @@
+"""Process lifecycle: stop cleanly on SIGINT/SIGTERM, and never outlive the launcher."""
+
+from __future__ import annotations
+
+import ctypes
+import logging
+import os
+import signal
+import sys
+import threading
+from types import FrameType
+
+log = logging.getLogger("anicov")
+
+EXIT_OK = 0
+EXIT_INCOMPLETE = 1
+EXIT_USAGE = 2
+EXIT_FAILED = 3
+EXIT_SIGINT = 130
+EXIT_SIGTERM = 143
+
+
+class StopFlag:
+    """Set by SIGINT or SIGTERM; main loops poll it and leave through their ``with`` blocks."""
+
+    def __init__(self) -> None:
+        self.event = threading.Event()
+        self.signal_number: int | None = None
+
+    def install(self) -> StopFlag:
+        signal.signal(signal.SIGINT, self._on_signal)
+        signal.signal(signal.SIGTERM, self._on_signal)
+        return self
+
+    def _on_signal(self, number: int, _frame: FrameType | None) -> None:
+        self.signal_number = number
+        self.event.set()
+
+    @property
+    def stopped(self) -> bool:
+        return self.event.is_set()
+
+    def exit_code(self, otherwise: int) -> int:
+        if self.signal_number == signal.SIGINT:
+            return EXIT_SIGINT
+        if self.signal_number == signal.SIGTERM:
+            return EXIT_SIGTERM
+        return otherwise
+
+
+def die_with_parent() -> None:
+    """Ask Linux to send SIGTERM to this process when its parent dies (no orphans after a SIGKILL)."""
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        pr_set_pdeathsig = 1
+        libc.prctl(pr_set_pdeathsig, signal.SIGTERM)
+    except OSError:
+        log.debug("prctl unavailable; relying on the launcher to stop this process")
+
+
+def parent_is_gone(original_parent: int) -> bool:
+    return os.getppid() != original_parent
+
+
+def setup_logging(name: str, verbose: bool = False) -> None:
+    logging.basicConfig(
+        level=logging.DEBUG if verbose else logging.INFO,
+        format=f"%(asctime)s {name} %(levelname)s %(message)s",
+        stream=sys.stderr,
+    )

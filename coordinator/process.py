@@ -1,0 +1,285 @@
+"""The coordinator process: Algorithms 1–2 for the team, membership, snapshots, the end of the run.
+
+It keeps its own replica of the map, gathers every agent's state, runs the
+planner (the same :class:`anicov.engine.Planner` as the in-process engine),
+and publishes each step's go with the objectives. It tracks who is alive
+through liveliness tokens, serves snapshots to late or restarted processes,
+detects full coverage, announces the end of the run and writes the run
+directory (trajectory.csv, summary.json, plots), as ``anicov run`` does.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import zenoh
+
+from anicov.engine import SNAPSHOT_PERIOD, TRACE_FIELDS, Planner, RunResult
+from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone
+from anicov.scenario import Scenario
+from protocol.bus import Inbox, Membership, Received, write_counts
+from protocol.keys import TeamKeys
+from protocol.messages import AgentState, Limits, MapDelta, Objectives, RunControl, encode
+from protocol.replica import MapReplica
+
+log = logging.getLogger("anicov.coordinator")
+
+START_TIMEOUT = 120.0
+"""Seconds to wait for every agent's hello before giving up."""
+STATUS_PERIOD = 0.25
+"""Seconds between progress messages on run/status."""
+
+
+@dataclass
+class CoordinatorOptions:
+    team: str
+    clock: str = "lockstep"
+    speed: float = 1.0
+    out: str | None = None
+    drop_rate: float = 0.0
+
+
+@dataclass
+class RunLog:
+    """What the coordinator saw of the run, enough to write the same outputs as the engine."""
+
+    agents: int
+    rows: dict[int, np.ndarray] = field(default_factory=dict)  # step → (N, 6), NaN where unseen
+    errors: list[float] = field(default_factory=lambda: [1.0])
+    final_poses: dict[int, tuple[float, float, float]] = field(default_factory=dict)
+    snapshot_times: list[float] = field(default_factory=list)
+    snapshots: list[np.ndarray] = field(default_factory=list)
+    events: list[str] = field(default_factory=list)
+    last_step: dict[int, int] = field(default_factory=dict)
+
+    def record(self, state: AgentState) -> None:
+        """Keep a state's trace row and, if it is the agent's latest, its pose at the end of the step."""
+        if state.step >= 0:
+            row = self.rows.get(state.step)
+            if row is None:
+                row = self.rows[state.step] = np.full((self.agents, len(TRACE_FIELDS)), np.nan)
+            row[state.agent] = (*state.pose, state.v, state.omega, state.e_omega)
+        if state.step >= self.last_step.get(state.agent, -2):
+            self.final_poses[state.agent] = state.next_pose
+            self.last_step[state.agent] = state.step
+
+
+class Coordinator:
+    def __init__(self, scenario: Scenario, options: CoordinatorOptions) -> None:
+        self.scenario = scenario
+        self.options = options
+        self.keys = TeamKeys(options.team)
+        rows, cols = scenario.grid_shape
+        self.limits = Limits(rows, cols, scenario.agents)
+        self.replica = MapReplica(rows, cols, scenario.cell, scenario.lambda_star)
+        self.planner = Planner(scenario)
+        self.inbox = Inbox(self.limits, options.drop_rate, seed=999)
+        self.alive: set[int] = set()
+        self.members: set[int] = set()
+        self.positions: dict[int, tuple[float, float]] = {}
+        self.latest_state_step: dict[int, int] = {}
+        self.log = RunLog(scenario.agents)
+        self.membership_changed = False
+        self.targets = np.zeros((0, 2))
+        self.bytes_sent = 0
+
+    def handle(self, item: Received | Membership) -> None:
+        if isinstance(item, Membership):
+            if item.alive:
+                self.alive.add(item.agent)
+            else:
+                self.alive.discard(item.agent)
+                if item.agent in self.members:
+                    self.members.discard(item.agent)
+                    self.membership_changed = True
+                    self.log.events.append(f"agent {item.agent} left")
+                    log.warning("agent %d left the team", item.agent)
+            return
+        message = item.message
+        if isinstance(message, MapDelta):
+            self.replica.apply(message)
+        elif isinstance(message, AgentState):
+            self.log.record(message)
+            if message.step >= self.latest_state_step.get(message.agent, -2):
+                self.latest_state_step[message.agent] = message.step
+                self.positions[message.agent] = (message.next_pose[0], message.next_pose[1])
+
+    def plan(self, step: int) -> Objectives:
+        members = sorted(self.members)
+        positions = np.array([self.positions[agent] for agent in members], dtype=np.float64).reshape(-1, 2)
+        if members and (
+            step % self.scenario.replan_steps == 0 or self.membership_changed or len(self.targets) != len(members)
+        ):
+            self.targets = self.planner.plan(self.replica.map.lack_of_coverage(), positions)
+            self.membership_changed = False
+        return Objectives(step, tuple(members), self.targets, self.planner.blobs.positions)
+
+    def step_complete(self, step: int) -> bool:
+        """Lockstep: every member's delta and state of ``step`` are in."""
+        return all(
+            self.replica.has(agent, step) and self.latest_state_step.get(agent, -2) >= step for agent in self.members
+        )
+
+    def take_snapshot(self, time_now: float) -> None:
+        lack = self.replica.map.lack_of_coverage()
+        self.log.snapshot_times.append(time_now)
+        self.log.snapshots.append(np.round(lack * 255.0).astype(np.uint8))
+
+    def result(self, steps: int, completed: bool, completion_step: int) -> RunResult:
+        n = self.scenario.agents
+        trace = np.full((steps + 1, n, len(TRACE_FIELDS)), np.nan)
+        for step, row in self.log.rows.items():
+            if step < steps:
+                trace[step] = row
+        for agent, pose in self.log.final_poses.items():
+            trace[steps, agent, :3] = pose
+            trace[steps, agent, 3:] = 0.0
+        errors = np.array(self.log.errors[: steps + 1])
+        return RunResult(
+            scenario=self.scenario,
+            completed=completed,
+            completion_time=completion_step * self.scenario.dt if completed else math.inf,
+            steps=steps,
+            trace=trace,
+            errors=errors,
+            snapshot_times=self.log.snapshot_times,
+            snapshots=self.log.snapshots,
+            final_lack=self.replica.map.lack_of_coverage(),
+        )
+
+
+def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zenoh.Config, stop: StopFlag) -> int:
+    node = Coordinator(scenario, options)
+    keys = node.keys
+    parent = os.getppid()
+    lockstep = options.clock == "lockstep"
+    outcome: tuple[int, bool, int] | None = None
+    with zenoh.open(config) as session:
+        session.declare_subscriber(keys.all_deltas, node.inbox.on_sample)
+        session.declare_subscriber(keys.all_states, node.inbox.on_sample)
+        session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
+        session.declare_queryable(
+            keys.snapshot, lambda query: query.reply(keys.snapshot, encode(node.replica.snapshot()))
+        )
+        objectives_publisher = session.declare_publisher(keys.objectives)
+        control_publisher = session.declare_publisher(keys.control)
+        status_publisher = session.declare_publisher(keys.status)
+        token = session.liveliness().declare_token(keys.alive("coordinator"))
+
+        def publish(publisher: zenoh.Publisher, payload: bytes) -> None:
+            node.bytes_sent += len(payload)
+            publisher.put(payload)
+
+        # Wait until every agent has said hello (its pose at t_0).
+        deadline = time.monotonic() + START_TIMEOUT
+        while len(node.positions) < scenario.agents and not stop.stopped and time.monotonic() < deadline:
+            item = node.inbox.get(timeout=0.1)
+            if item is not None:
+                node.handle(item)
+            if parent_is_gone(parent):
+                stop.event.set()
+        if len(node.positions) < scenario.agents:
+            log.error("only %d of %d agents said hello; giving up", len(node.positions), scenario.agents)
+            publish(control_publisher, encode(RunControl("abort", 0, reason="agents missing at start")))
+            token.undeclare()
+            return stop.exit_code(EXIT_FAILED)
+        node.members = set(range(scenario.agents))
+        log.info("all %d agents present; starting (%s clock)", scenario.agents, options.clock)
+        node.take_snapshot(0.0)
+        snapshot_steps = max(1, round(SNAPSHOT_PERIOD / scenario.dt))
+        last_status = 0.0
+        step = 0
+        started = time.monotonic()
+        next_plan = started
+        publish(objectives_publisher, encode(node.plan(0)))
+        while outcome is None and not stop.stopped:
+            if parent_is_gone(parent):
+                stop.event.set()
+                break
+            if lockstep:
+                while not node.step_complete(step) and not stop.stopped:
+                    item = node.inbox.get(timeout=0.5)
+                    if item is not None:
+                        node.handle(item)
+                if stop.stopped:
+                    break
+                step += 1
+                node.log.errors.append(node.replica.map.domain_error())
+                if step % snapshot_steps == 0:
+                    node.take_snapshot(step * scenario.dt)
+                if node.replica.map.complete or step >= scenario.max_steps or not node.members:
+                    outcome = (step, node.replica.map.complete, step)
+                    break
+                publish(objectives_publisher, encode(node.plan(step)))
+            else:
+                item = node.inbox.get(timeout=0.01)
+                while item is not None:
+                    node.handle(item)
+                    item = node.inbox.get(timeout=0)
+                reached = max(node.latest_state_step.values(), default=-1) + 1
+                while len(node.log.errors) <= reached:
+                    node.log.errors.append(node.replica.map.domain_error())
+                    if (len(node.log.errors) - 1) % snapshot_steps == 0:
+                        node.take_snapshot((len(node.log.errors) - 1) * scenario.dt)
+                if node.replica.map.complete or reached >= scenario.max_steps or not node.members:
+                    outcome = (reached, node.replica.map.complete, reached)
+                    break
+                now = time.monotonic()
+                if now >= next_plan:
+                    step = int((now - started) * options.speed / scenario.dt)
+                    objectives = node.plan(0)  # as step 0 of a block: replan on every wall-clock period
+                    publish(
+                        objectives_publisher,
+                        encode(Objectives(step, objectives.members, objectives.targets, objectives.blobs)),
+                    )
+                    next_plan = now + scenario.replan_period / options.speed
+            now = time.monotonic()
+            if now - last_status >= STATUS_PERIOD:
+                publish(status_publisher, encode(RunControl("status", step, False, node.replica.map.domain_error())))
+                last_status = now
+        if outcome is not None:
+            steps, completed, completion_step = outcome
+            publish(control_publisher, encode(RunControl("done", steps, completed, node.replica.map.domain_error())))
+            log.info(
+                "run %s after %d steps (e_D = %.4f)",
+                "complete" if completed else "incomplete",
+                steps,
+                node.replica.map.domain_error(),
+            )
+        else:
+            publish(
+                control_publisher,
+                encode(RunControl("abort", step, False, node.replica.map.domain_error(), reason="coordinator stopped")),
+            )
+        token.undeclare()
+        counts = node.inbox.counts() | {
+            "bytes_sent": node.bytes_sent,
+            "duplicates": node.replica.duplicates,
+            "gaps": sum(len(v) for v in node.replica.gaps().values()),
+            "wall_seconds": time.monotonic() - started,
+            "events": node.log.events,
+        }
+    if outcome is None:
+        return stop.exit_code(EXIT_FAILED)
+    steps, completed, completion_step = outcome
+    if options.out:
+        write_run_directory(node.result(steps, completed, completion_step), Path(options.out), counts)
+    return EXIT_OK if completed else EXIT_INCOMPLETE
+
+
+def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, object]) -> None:
+    """trajectory.csv, summary.json and plots, exactly as ``anicov run`` writes them."""
+    from anicov.outputs import summary_of, write_summary, write_trajectory
+    from anicov.plots import write_run_plots
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_trajectory(result, out_dir / "trajectory.csv")
+    write_summary(summary_of(result), out_dir / "summary.json")
+    write_counts(out_dir / "coordinator_counts.json", counts)
+    write_run_plots(result, out_dir)

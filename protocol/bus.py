@@ -1,0 +1,151 @@
+"""The Zenoh side of a process: configuration, and an inbox that decodes, validates and counts.
+
+Zenoh delivers samples on its own threads. The inbox decodes each sample at
+once (a bad payload is rejected, logged and counted there, never queued) and
+hands good messages to the process's single main thread through a queue, so
+the control code never runs concurrently with itself.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import queue
+import threading
+import time
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+import zenoh
+
+from protocol.keys import agent_of_key
+from protocol.messages import Limits, Message, ProtocolError, decode
+
+log = logging.getLogger("anicov.bus")
+
+DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
+
+
+def zenoh_config(
+    mode: str = "client",
+    connect: list[str] | None = None,
+    listen: list[str] | None = None,
+    config_file: str | None = None,
+) -> zenoh.Config:
+    """A Zenoh config: from a JSON5 file if given, else built from flags; multicast scouting off.
+
+    Endpoints are explicit so that parallel teams (and parallel tests) never
+    discover each other.
+    """
+    config = zenoh.Config.from_file(config_file) if config_file else zenoh.Config()
+    if not config_file:
+        config.insert_json5("mode", json.dumps(mode))
+        config.insert_json5("scouting/multicast/enabled", "false")
+        # Loopback links of a single host: a lost peer is noticed within the lease.
+    if connect:
+        config.insert_json5("connect/endpoints", json.dumps(connect))
+    if listen:
+        config.insert_json5("listen/endpoints", json.dumps(listen))
+    return config
+
+
+def open_session(config: zenoh.Config, attempts: int = 40, delay: float = 0.25) -> zenoh.Session:
+    """Open a session, retrying while the router is not up yet (a robot may boot before it)."""
+    for attempt in range(attempts):
+        try:
+            return zenoh.open(config)
+        except zenoh.ZError as error:
+            if attempt == attempts - 1:
+                raise
+            log.debug("zenoh open failed (%s), retrying", error)
+            time.sleep(delay)
+    raise RuntimeError("unreachable")
+
+
+@dataclass(frozen=True)
+class Received:
+    key: str
+    message: Message
+
+
+@dataclass(frozen=True)
+class Membership:
+    agent: int
+    alive: bool
+
+
+class Inbox:
+    """Validated messages (and liveliness changes) for the main thread, with rejection counts."""
+
+    def __init__(self, limits: Limits, drop_rate: float = 0.0, seed: int = 0) -> None:
+        self.limits = limits
+        self.queue: queue.SimpleQueue[Received | Membership] = queue.SimpleQueue()
+        self.rejected: Counter[str] = Counter()
+        self.accepted = 0
+        self.bytes_received = 0
+        self._lock = threading.Lock()
+        # Test hook (issue 5): drop this fraction of incoming samples at random.
+        self._drop_rate = drop_rate
+        self._drop_random = __import__("random").Random(seed)
+        self.dropped = 0
+
+    def on_sample(self, sample: zenoh.Sample) -> None:
+        key = str(sample.key_expr)
+        try:
+            payload = sample.payload.to_bytes()
+        except Exception:  # a payload Zenoh cannot hand over as bytes
+            self._reject("unreadable", key)
+            return
+        with self._lock:
+            self.bytes_received += len(payload)
+            if self._drop_rate and self._drop_random.random() < self._drop_rate:
+                self.dropped += 1
+                return
+        try:
+            message = decode(payload, self.limits)
+            sender = agent_of_key(key)
+            agent = getattr(message, "agent", None)
+            if "/agent/" in key and agent is not None and agent != sender:
+                raise ProtocolError("wrong-sender", f"agent {agent} published on {key}")
+        except ProtocolError as error:
+            self._reject(error.reason, key, str(error))
+            return
+        with self._lock:
+            self.accepted += 1
+        self.queue.put(Received(key, message))
+
+    def on_liveliness(self, sample: zenoh.Sample) -> None:
+        agent = agent_of_key(str(sample.key_expr))
+        if agent is not None and 0 <= agent < self.limits.agents:
+            self.queue.put(Membership(agent, sample.kind == zenoh.SampleKind.PUT))
+
+    def _reject(self, reason: str, key: str, detail: str = "") -> None:
+        with self._lock:
+            self.rejected[reason] += 1
+            count = self.rejected[reason]
+        # Log the first few of each reason, then every 1000th: a flood must not flood the log.
+        if count <= 3 or count % 1000 == 0:
+            log.warning("rejected payload on %s: %s (%d so far)", key, detail or reason, count)
+
+    def get(self, timeout: float | None) -> Received | Membership | None:
+        try:
+            return self.queue.get(timeout=timeout) if timeout is None or timeout > 0 else self.queue.get_nowait()
+        except queue.Empty:
+            return None
+
+    def counts(self) -> dict[str, int]:
+        with self._lock:
+            return {
+                "accepted": self.accepted,
+                "rejected": sum(self.rejected.values()),
+                "dropped": self.dropped,
+                "bytes_received": self.bytes_received,
+                **{f"rejected.{k}": v for k, v in self.rejected.items()},
+            }
+
+
+def write_counts(path: Path | None, counts: dict[str, object]) -> None:
+    """Persist a process's message counters (read by tests and the launcher's summary)."""
+    if path is not None:
+        path.write_text(json.dumps(counts, indent=2, sort_keys=True) + "\n", encoding="utf-8")

@@ -1,0 +1,87 @@
+"""Zenoh key expressions of a team. Everything lives under ``anicov/<team>/``.
+
+anicov/<team>/agent/<id>/delta        MapDelta      agent → all      coverage it added in one step
+anicov/<team>/agent/<id>/state        AgentState    agent → all      pose, (v, ω), e_Ω of one step
+anicov/<team>/coordinator/objectives  Objectives    coordinator → all  go for step k, with targets
+anicov/<team>/coordinator/snapshot    (queryable)   coordinator      map + last sequences, for late joiners
+anicov/<team>/run/control             RunControl    coordinator → all  run done / aborted
+anicov/<team>/run/status              RunControl    coordinator → all  progress (e_D, step)
+anicov/<team>/alive/<role>/<id>       liveliness tokens: agent/<id>, coordinator/0, logger/0
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+ROOT = "anicov"
+_TEAM_NAME = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
+
+
+def check_team_name(team: str) -> str:
+    """A team name is 1–64 letters, digits, '-' or '_' (no key-expression wildcards)."""
+    if not _TEAM_NAME.match(team):
+        raise ValueError(f"team name {team!r}: expected 1-64 characters from A-Z a-z 0-9 _ -")
+    return team
+
+
+@dataclass(frozen=True)
+class TeamKeys:
+    team: str
+
+    def __post_init__(self) -> None:
+        check_team_name(self.team)
+
+    @property
+    def prefix(self) -> str:
+        return f"{ROOT}/{self.team}"
+
+    def agent_delta(self, agent: int) -> str:
+        return f"{self.prefix}/agent/{agent}/delta"
+
+    def agent_state(self, agent: int) -> str:
+        return f"{self.prefix}/agent/{agent}/state"
+
+    @property
+    def all_deltas(self) -> str:
+        return f"{self.prefix}/agent/*/delta"
+
+    @property
+    def all_states(self) -> str:
+        return f"{self.prefix}/agent/*/state"
+
+    @property
+    def objectives(self) -> str:
+        return f"{self.prefix}/coordinator/objectives"
+
+    @property
+    def snapshot(self) -> str:
+        return f"{self.prefix}/coordinator/snapshot"
+
+    @property
+    def control(self) -> str:
+        return f"{self.prefix}/run/control"
+
+    @property
+    def status(self) -> str:
+        return f"{self.prefix}/run/status"
+
+    def alive(self, role: str, ident: int = 0) -> str:
+        return f"{self.prefix}/alive/{role}/{ident}"
+
+    @property
+    def alive_agents(self) -> str:
+        return f"{self.prefix}/alive/agent/*"
+
+    @property
+    def everything(self) -> str:
+        return f"{self.prefix}/**"
+
+
+def agent_of_key(key: str) -> int | None:
+    """The agent id in ``.../agent/<id>/...`` or ``.../alive/agent/<id>``, if any and well-formed."""
+    parts = key.split("/")
+    for index, part in enumerate(parts[:-1]):
+        if part == "agent" and parts[index + 1].isdigit() and len(parts[index + 1]) <= 6:
+            return int(parts[index + 1])
+    return None

@@ -1,0 +1,310 @@
+"""Message types of the team protocol, encoded with msgpack, versioned and validated.
+
+Every payload is a msgpack map ``{"v": PROTOCOL_VERSION, "type": ..., ...}``.
+Encoding never fails for a well-formed value; decoding checks everything a
+receiver relies on (version, type, field types, shapes, finite numbers, ids in
+range, map windows inside the grid, non-negative deltas) and raises
+:class:`ProtocolError` with a short reason otherwise. Nothing that fails to
+decode may touch a map or a controller.
+
+    MapDelta    agent, seq (= step), window (row0, col0, ticks int64 h×w)   eq. 3
+    AgentState  agent, step, pose at t_k, v, ω, e_Ω, pose at t_k+1
+    Objectives  step k, members, targets (one per member), blob objectives  Alg. 1–2
+    RunControl  kind (done | abort | status), step, completed, e_D, reason
+    Snapshot    the coverage map and the applied sequences per agent
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from dataclasses import dataclass, field
+from typing import Any
+
+import msgpack
+import numpy as np
+
+PROTOCOL_VERSION = 1
+MAX_PAYLOAD_BYTES = 8 * 1024 * 1024
+"""Larger payloads are rejected before decoding (a snapshot of a 1000×1000 map compresses far below)."""
+
+
+class ProtocolError(ValueError):
+    """A payload that cannot be accepted; ``reason`` is a short, countable label."""
+
+    def __init__(self, reason: str, detail: str = "") -> None:
+        super().__init__(f"{reason}: {detail}" if detail else reason)
+        self.reason = reason
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What a receiver accepts: the grid it holds and the team size."""
+
+    rows: int
+    cols: int
+    agents: int
+
+
+Pose = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class MapDelta:
+    agent: int
+    seq: int
+    row0: int
+    col0: int
+    ticks: np.ndarray  # int64 (h, w), non-negative
+
+
+@dataclass(frozen=True)
+class AgentState:
+    agent: int
+    step: int  # -1: hello, the pose at t_0 in next_pose
+    pose: Pose
+    v: float
+    omega: float
+    e_omega: float
+    next_pose: Pose
+
+
+@dataclass(frozen=True)
+class Objectives:
+    step: int
+    members: tuple[int, ...]
+    targets: np.ndarray  # (len(members), 2): target of members[i]
+    blobs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # Ψ of Alg. 1
+
+    def target_of(self, agent: int) -> tuple[float, float] | None:
+        if agent not in self.members:
+            return None
+        x, y = self.targets[self.members.index(agent)]
+        return float(x), float(y)
+
+
+RUN_CONTROL_KINDS = ("done", "abort", "status")
+
+
+@dataclass(frozen=True)
+class RunControl:
+    kind: str
+    step: int
+    completed: bool = False
+    domain_error: float = 1.0
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    coverage: np.ndarray  # int64 (rows, cols)
+    applied: dict[int, tuple[int, tuple[int, ...]]]  # agent → (contiguous seq, extra seqs)
+
+
+Message = MapDelta | AgentState | Objectives | RunControl | Snapshot
+
+
+# ---------------------------------------------------------------- encoding
+
+
+def _pack(kind: str, body: dict[str, Any]) -> bytes:
+    return msgpack.packb({"v": PROTOCOL_VERSION, "type": kind, **body}, use_bin_type=True)
+
+
+def encode(message: Message) -> bytes:
+    if isinstance(message, MapDelta):
+        ticks = np.ascontiguousarray(message.ticks, dtype="<i8")
+        return _pack(
+            "delta",
+            {
+                "agent": message.agent,
+                "seq": message.seq,
+                "row0": message.row0,
+                "col0": message.col0,
+                "h": ticks.shape[0],
+                "w": ticks.shape[1],
+                "ticks": ticks.tobytes(),
+            },
+        )
+    if isinstance(message, AgentState):
+        return _pack(
+            "state",
+            {
+                "agent": message.agent,
+                "step": message.step,
+                "pose": list(message.pose),
+                "vel": [message.v, message.omega],
+                "e_omega": message.e_omega,
+                "next": list(message.next_pose),
+            },
+        )
+    if isinstance(message, Objectives):
+        return _pack(
+            "objectives",
+            {
+                "step": message.step,
+                "members": list(message.members),
+                "targets": np.asarray(message.targets, float).ravel().tolist(),
+                "blobs": np.asarray(message.blobs, float).ravel().tolist(),
+            },
+        )
+    if isinstance(message, RunControl):
+        return _pack(
+            "control",
+            {
+                "kind": message.kind,
+                "step": message.step,
+                "completed": message.completed,
+                "e_d": message.domain_error,
+                "reason": message.reason,
+            },
+        )
+    if isinstance(message, Snapshot):
+        coverage = np.ascontiguousarray(message.coverage, dtype="<i8")
+        applied = [[agent, seq, list(extra)] for agent, (seq, extra) in sorted(message.applied.items())]
+        return _pack(
+            "snapshot",
+            {
+                "rows": coverage.shape[0],
+                "cols": coverage.shape[1],
+                "map": zlib.compress(coverage.tobytes(), 1),
+                "applied": applied,
+            },
+        )
+    raise TypeError(f"not a protocol message: {type(message).__name__}")
+
+
+# ---------------------------------------------------------------- decoding
+
+
+def _int(body: dict[str, Any], key: str, low: int, high: int) -> int:
+    value = body.get(key)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ProtocolError("bad-field", f"{key} must be an integer")
+    if not low <= value <= high:
+        raise ProtocolError("out-of-range", f"{key}={value} not in [{low}, {high}]")
+    return value
+
+
+def _finite(value: Any, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ProtocolError("not-finite", f"{name} must be a finite number")
+    return float(value)
+
+
+def _floats(body: dict[str, Any], key: str, length: int | None = None) -> list[float]:
+    value = body.get(key)
+    if not isinstance(value, list) or (length is not None and len(value) != length):
+        raise ProtocolError("bad-shape", f"{key} must be a list" + (f" of {length}" if length else ""))
+    return [_finite(item, key) for item in value]
+
+
+def _header(payload: bytes) -> dict[str, Any]:
+    if not isinstance(payload, bytes | bytearray | memoryview):
+        raise ProtocolError("not-bytes")
+    if len(payload) > MAX_PAYLOAD_BYTES:
+        raise ProtocolError("too-large", f"{len(payload)} bytes")
+    try:
+        body = msgpack.unpackb(payload, raw=False, strict_map_key=True, max_bin_len=MAX_PAYLOAD_BYTES)
+    except Exception as error:  # msgpack raises several unrelated types on garbage
+        raise ProtocolError("undecodable", type(error).__name__) from None
+    if not isinstance(body, dict):
+        raise ProtocolError("not-a-map")
+    if body.get("v") != PROTOCOL_VERSION:
+        raise ProtocolError("bad-version", f"expected {PROTOCOL_VERSION}, got {body.get('v')!r}")
+    return body
+
+
+MAX_STEP = 2**40
+
+
+def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Message:
+    """Decode and validate one payload; raise ProtocolError (with ``.reason``) if it is not acceptable."""
+    body = _header(payload)
+    kind = body.get("type")
+    if expected is not None and kind != expected:
+        raise ProtocolError("wrong-type", f"expected {expected}, got {kind!r}")
+    last_agent = limits.agents - 1
+    if kind == "delta":
+        agent = _int(body, "agent", 0, last_agent)
+        seq = _int(body, "seq", 0, MAX_STEP)
+        height = _int(body, "h", 0, limits.rows)
+        width = _int(body, "w", 0, limits.cols)
+        row0 = _int(body, "row0", 0, limits.rows)
+        col0 = _int(body, "col0", 0, limits.cols)
+        if row0 + height > limits.rows or col0 + width > limits.cols:
+            raise ProtocolError("window-outside-grid", f"{height}x{width} at ({row0}, {col0})")
+        raw = body.get("ticks")
+        if not isinstance(raw, bytes) or len(raw) != 8 * height * width:
+            raise ProtocolError("bad-shape", "ticks must hold h*w int64")
+        ticks = np.frombuffer(raw, dtype="<i8").reshape(height, width).astype(np.int64)
+        if (ticks < 0).any():
+            raise ProtocolError("negative-delta")
+        return MapDelta(agent, seq, row0, col0, ticks)
+    if kind == "state":
+        pose = _floats(body, "pose", 3)
+        vel = _floats(body, "vel", 2)
+        nxt = _floats(body, "next", 3)
+        e_omega = _finite(body.get("e_omega"), "e_omega")
+        if not 0.0 <= e_omega <= 1.0:
+            raise ProtocolError("out-of-range", "e_omega not in [0, 1]")
+        return AgentState(
+            _int(body, "agent", 0, last_agent),
+            _int(body, "step", -1, MAX_STEP),
+            (pose[0], pose[1], pose[2]),
+            vel[0],
+            vel[1],
+            e_omega,
+            (nxt[0], nxt[1], nxt[2]),
+        )
+    if kind == "objectives":
+        step = _int(body, "step", 0, MAX_STEP)
+        members = body.get("members")
+        if not isinstance(members, list) or any(isinstance(m, bool) or not isinstance(m, int) for m in members):
+            raise ProtocolError("bad-field", "members must be a list of integers")
+        if any(not 0 <= m <= last_agent for m in members) or len(set(members)) != len(members):
+            raise ProtocolError("out-of-range", "members must be distinct agent ids")
+        targets = _floats(body, "targets", 2 * len(members))
+        blobs = _floats(body, "blobs")
+        if len(blobs) % 2:
+            raise ProtocolError("bad-shape", "blobs must hold (x, y) pairs")
+        return Objectives(step, tuple(members), np.array(targets).reshape(-1, 2), np.array(blobs).reshape(-1, 2))
+    if kind == "control":
+        control_kind = body.get("kind")
+        if control_kind not in RUN_CONTROL_KINDS:
+            raise ProtocolError("bad-field", f"kind must be one of {RUN_CONTROL_KINDS}")
+        completed = body.get("completed")
+        reason = body.get("reason")
+        if not isinstance(completed, bool) or not isinstance(reason, str) or len(reason) > 1000:
+            raise ProtocolError("bad-field", "completed must be a bool and reason a short string")
+        return RunControl(
+            control_kind, _int(body, "step", 0, MAX_STEP), completed, _finite(body.get("e_d"), "e_d"), reason
+        )
+    if kind == "snapshot":
+        rows = _int(body, "rows", limits.rows, limits.rows)
+        cols = _int(body, "cols", limits.cols, limits.cols)
+        packed = body.get("map")
+        if not isinstance(packed, bytes):
+            raise ProtocolError("bad-field", "map must be bytes")
+        try:
+            raw = zlib.decompressobj().decompress(packed, 8 * rows * cols + 1)
+        except zlib.error:
+            raise ProtocolError("undecodable", "map is not zlib data") from None
+        if len(raw) != 8 * rows * cols:
+            raise ProtocolError("bad-shape", "map must hold rows*cols int64")
+        coverage = np.frombuffer(raw, dtype="<i8").reshape(rows, cols).astype(np.int64)
+        if (coverage < 0).any():
+            raise ProtocolError("negative-delta", "map cells must be non-negative")
+        applied_raw = body.get("applied")
+        if not isinstance(applied_raw, list):
+            raise ProtocolError("bad-field", "applied must be a list")
+        applied: dict[int, tuple[int, tuple[int, ...]]] = {}
+        for entry in applied_raw:
+            if not (isinstance(entry, list) and len(entry) == 3 and isinstance(entry[2], list)):
+                raise ProtocolError("bad-shape", "applied entries are [agent, seq, extras]")
+            agent = _int({"a": entry[0]}, "a", 0, last_agent)
+            seq = _int({"s": entry[1]}, "s", -1, MAX_STEP)
+            extras = tuple(_int({"e": item}, "e", seq + 1, MAX_STEP) for item in entry[2])
+            applied[agent] = (seq, extras)
+        return Snapshot(coverage, applied)
+    raise ProtocolError("unknown-type", repr(kind)[:40])

@@ -1,0 +1,79 @@
+"""A replica of the team's coverage map: each (agent, sequence) delta applied exactly once.
+
+Deltas are integer windows, so the map is the same whatever order they
+arrive in. Per agent the replica remembers the highest sequence up to which
+every delta was applied (``contiguous``) and the ones applied beyond it
+(``extras``): anything in between is a gap, a delta known to be missing.
+A snapshot carries the map with that bookkeeping, so a late or restarted
+process can load it and keep applying deltas without double counting.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from protocol.coverage_map import CoverageMap
+from protocol.messages import MapDelta, Snapshot
+
+
+@dataclass
+class AppliedSequences:
+    contiguous: int = -1
+    extras: set[int] = field(default_factory=set)
+
+    def contains(self, seq: int) -> bool:
+        return seq <= self.contiguous or seq in self.extras
+
+    def add(self, seq: int) -> None:
+        self.extras.add(seq)
+        while self.contiguous + 1 in self.extras:
+            self.contiguous += 1
+            self.extras.discard(self.contiguous)
+
+    def gaps(self) -> list[int]:
+        if not self.extras:
+            return []
+        return [seq for seq in range(self.contiguous + 1, max(self.extras)) if seq not in self.extras]
+
+
+class MapReplica:
+    """A CoverageMap plus exactly-once bookkeeping of who contributed what."""
+
+    def __init__(self, rows: int, cols: int, cell: float, coverage_target: float) -> None:
+        self.map = CoverageMap(rows, cols, cell, coverage_target)
+        self.applied: dict[int, AppliedSequences] = {}
+        self.duplicates = 0
+
+    def has(self, agent: int, seq: int) -> bool:
+        sequences = self.applied.get(agent)
+        return sequences is not None and sequences.contains(seq)
+
+    def apply(self, delta: MapDelta) -> bool:
+        """Add a delta unless this (agent, seq) was applied before; True if it was new."""
+        sequences = self.applied.setdefault(delta.agent, AppliedSequences())
+        if sequences.contains(delta.seq):
+            self.duplicates += 1
+            return False
+        self.map.add(delta.row0, delta.col0, delta.ticks)
+        sequences.add(delta.seq)
+        return True
+
+    def gaps(self) -> dict[int, list[int]]:
+        """Known-missing sequences per agent (a later one arrived, these did not)."""
+        return {agent: missing for agent, seqs in self.applied.items() if (missing := seqs.gaps())}
+
+    def snapshot(self) -> Snapshot:
+        applied = {agent: (seqs.contiguous, tuple(sorted(seqs.extras))) for agent, seqs in self.applied.items()}
+        return Snapshot(self.map.coverage.copy(), applied)
+
+    def load(self, snapshot: Snapshot) -> None:
+        """Replace this replica's content by a snapshot (of the same grid)."""
+        if snapshot.coverage.shape != self.map.coverage.shape:
+            raise ValueError("snapshot grid differs from this replica's")
+        target = self.map.target_ticks
+        self.map.coverage[...] = snapshot.coverage
+        self.map.uncovered_cells = int((snapshot.coverage < target).sum())
+        self.map.deficit_ticks = int(np.maximum(target - snapshot.coverage, 0).sum())
+        self.applied = {agent: AppliedSequences(seq, set(extras)) for agent, (seq, extras) in snapshot.applied.items()}
