@@ -7,10 +7,14 @@ teammates' deltas and follows the coordinator's objectives.
 
 Clocks:
 
-- ``lockstep``: step k starts when the coordinator's go for step k has
-  arrived and every member's step k−1 delta is in the replica; teammates'
-  deltas of step k or later are held back until this agent has done step k.
-  The result equals the in-process engine bit for bit.
+- ``lockstep``: step k starts when every member's step k−1 delta is in the
+  replica and, on a replanning step, the coordinator's go for step k (with
+  the new objectives) has arrived; teammates' deltas of step k or later are
+  held back until this agent has done step k. Between replanning steps the
+  agents pace each other directly, so the coordinator is off the critical
+  path. Every replica then holds exactly the engine's Λ_k at step k, every
+  agent sees full coverage at the same step, and the run equals the
+  in-process engine bit for bit.
 - ``realtime``: one step every dt/speed seconds of wall-clock time, with
   whatever has arrived by then; never waits for anyone.
 """
@@ -29,7 +33,7 @@ from agents.step import LawParameters, decide_and_sense
 from anicov.engine import initial_poses, law_parameters
 from anicov.lifecycle import EXIT_FAILED, EXIT_OK, StopFlag, parent_is_gone
 from anicov.scenario import Scenario
-from protocol.bus import Inbox, Membership, Received, write_counts
+from protocol.bus import Inbox, Membership, Received, team_publisher, write_counts
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
@@ -76,6 +80,7 @@ class AgentNode:
         self.step = 0
         self.objective: tuple[float, float] | None = None
         self.go: Objectives | None = None
+        self.next_go: Objectives | None = None
         self.held_back: list[MapDelta] = []
         self.finished: RunControl | None = None
         self.bytes_sent = 0
@@ -94,13 +99,19 @@ class AgentNode:
             else:
                 self.replica.apply(message)
         elif isinstance(message, Objectives):
-            if not hold_back or message.step == self.step:
-                self.go = message
-                target = message.target_of(self.options.agent)
-                if target is not None:
-                    self.objective = target
+            if hold_back and message.step > self.step:
+                self.next_go = message  # a go for a step this agent has not reached yet
+            else:
+                self.accept(message)
         elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
             self.finished = message
+
+    def accept(self, objectives: Objectives) -> None:
+        """Take a go (or, from an earlier step, a membership update) with this agent's target."""
+        self.go = objectives
+        target = objectives.target_of(self.options.agent)
+        if target is not None:
+            self.objective = target
 
     def release_held_back(self) -> None:
         """Deltas of steps before the next one may now enter the replica."""
@@ -113,14 +124,32 @@ class AgentNode:
         self.held_back = keep
 
     def ready_for_step(self) -> bool:
-        """Lockstep: the go for this step is here and so is every member's previous delta."""
-        if self.go is None or self.go.step != self.step or self.objective is None:
+        """Lockstep: every member's previous delta is here, and on a replanning step so is its go.
+
+        Never ready once the replica is fully covered or max_time is reached:
+        the agent then waits for the coordinator's end of run.
+        """
+        if self.replica.map.complete or self.step >= self.scenario.max_steps:
             return False
-        if self.step == 0:
-            return True
+        if self.next_go is not None and self.next_go.step <= self.step:
+            self.accept(self.next_go)
+            self.next_go = None
+        if self.go is None or self.objective is None:
+            return False
+        if self.step % self.scenario.replan_steps == 0 and self.go.step != self.step:
+            return False
         return all(
             self.replica.has(member, self.step - 1) for member in self.go.members if member != self.options.agent
         )
+
+    def waiting_for(self) -> str:
+        """What a lockstep step is waiting on, for the log."""
+        if self.go is None:
+            return "the coordinator's first go"
+        if self.step % self.scenario.replan_steps == 0 and self.go.step != self.step:
+            return f"the coordinator's go for step {self.step}"
+        missing = [m for m in self.go.members if m != self.options.agent and not self.replica.has(m, self.step - 1)]
+        return f"deltas of step {self.step - 1} from agents {missing}"
 
     # ------------------------------------------------------------ control
 
@@ -168,8 +197,8 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         session.declare_subscriber(keys.all_deltas, node.inbox.on_sample)
         session.declare_subscriber(keys.objectives, node.inbox.on_sample)
         session.declare_subscriber(keys.control, node.inbox.on_sample)
-        delta_publisher = session.declare_publisher(keys.agent_delta(options.agent))
-        state_publisher = session.declare_publisher(keys.agent_state(options.agent))
+        delta_publisher = team_publisher(session, keys.agent_delta(options.agent))
+        state_publisher = team_publisher(session, keys.agent_state(options.agent))
         token = session.liveliness().declare_token(keys.alive("agent", options.agent))
 
         def publish(delta: MapDelta, state: AgentState) -> None:
@@ -196,10 +225,14 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         first_step = node.step
         while node.finished is None and not stop.stopped and not parent_is_gone(parent):
             if lockstep:
+                waiting_since = time.monotonic()
                 while not node.ready_for_step() and node.finished is None and not stop.stopped:
                     item = node.inbox.get(timeout=0.5)
                     if item is not None:
                         node.handle(item, hold_back=True)
+                    if time.monotonic() - waiting_since > 5.0:
+                        log.info("agent %d still waiting at step %d: %s", options.agent, node.step, node.waiting_for())
+                        waiting_since = time.monotonic()
                 if node.finished is not None or stop.stopped:
                     break
                 publish(*node.control_step())

@@ -44,7 +44,7 @@ class Child:
 
 
 def add_team_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--n", type=int, help="team size (overrides 'agents'; default 4 for launch)")
+    parser.add_argument("--n", type=int, help="team size (overrides the scenario's 'agents'; the paper's is 4)")
     parser.add_argument("--config", help="scenario TOML (default: scenarios/paper.toml)")
     parser.add_argument("--seed", type=int, help="seed of the initial poses")
     parser.add_argument("--controller", choices=[c for c in CONTROLLERS if c != "zigzag"], help="control law")
@@ -152,8 +152,6 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     setup_logging("launch")
     stop = StopFlag().install()
-    if args.n is None:
-        args.n = 4
     from anicov.cli import resolve_scenario
 
     try:

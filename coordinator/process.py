@@ -23,7 +23,7 @@ import zenoh
 from anicov.engine import SNAPSHOT_PERIOD, TRACE_FIELDS, Planner, RunResult
 from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone
 from anicov.scenario import Scenario
-from protocol.bus import Inbox, Membership, Received, write_counts
+from protocol.bus import Inbox, Membership, Received, team_publisher, write_counts
 from protocol.keys import TeamKeys
 from protocol.messages import AgentState, Limits, MapDelta, Objectives, RunControl, encode
 from protocol.replica import MapReplica
@@ -88,6 +88,8 @@ class Coordinator:
         self.membership_changed = False
         self.targets = np.zeros((0, 2))
         self.bytes_sent = 0
+        self.open_step: int | None = 0 if options.clock == "lockstep" else None
+        self.held_back: list[MapDelta] = []
 
     def handle(self, item: Received | Membership) -> None:
         if isinstance(item, Membership):
@@ -103,12 +105,25 @@ class Coordinator:
             return
         message = item.message
         if isinstance(message, MapDelta):
-            self.replica.apply(message)
+            if self.open_step is not None and message.seq > self.open_step:
+                self.held_back.append(message)  # lockstep: Λ must not run ahead of the step being closed
+            else:
+                self.replica.apply(message)
         elif isinstance(message, AgentState):
             self.log.record(message)
             if message.step >= self.latest_state_step.get(message.agent, -2):
                 self.latest_state_step[message.agent] = message.step
                 self.positions[message.agent] = (message.next_pose[0], message.next_pose[1])
+
+    def open_next_step(self) -> None:
+        """Lockstep: after the open step was closed (Λ_{k+1} measured), let step k+1's deltas in."""
+        assert self.open_step is not None
+        self.open_step += 1
+        waiting = [delta for delta in self.held_back if delta.seq > self.open_step]
+        for delta in self.held_back:
+            if delta.seq <= self.open_step:
+                self.replica.apply(delta)
+        self.held_back = waiting
 
     def plan(self, step: int) -> Objectives:
         members = sorted(self.members)
@@ -167,9 +182,9 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         session.declare_queryable(
             keys.snapshot, lambda query: query.reply(keys.snapshot, encode(node.replica.snapshot()))
         )
-        objectives_publisher = session.declare_publisher(keys.objectives)
-        control_publisher = session.declare_publisher(keys.control)
-        status_publisher = session.declare_publisher(keys.status)
+        objectives_publisher = team_publisher(session, keys.objectives)
+        control_publisher = team_publisher(session, keys.control)
+        status_publisher = team_publisher(session, keys.status)
         token = session.liveliness().declare_token(keys.alive("coordinator"))
 
         def publish(publisher: zenoh.Publisher, payload: bytes) -> None:
@@ -203,20 +218,28 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                 stop.event.set()
                 break
             if lockstep:
-                while not node.step_complete(step) and not stop.stopped:
-                    item = node.inbox.get(timeout=0.5)
-                    if item is not None:
-                        node.handle(item)
-                if stop.stopped:
+                # Close steps in order as their deltas and states come in; the agents pace
+                # each other between replanning steps, the go is needed on those only.
+                item = node.inbox.get(timeout=0.5)
+                if item is not None:
+                    node.handle(item)
+                while outcome is None and node.step_complete(step):
+                    # The replica now holds exactly Λ_{k+1}: every delta of steps ≤ k, none later.
+                    step += 1
+                    node.log.errors.append(node.replica.map.domain_error())
+                    if step % snapshot_steps == 0:
+                        node.take_snapshot(step * scenario.dt)
+                    if node.replica.map.complete or step >= scenario.max_steps or not node.members:
+                        outcome = (step, node.replica.map.complete, step)
+                        break
+                    node.open_next_step()
+                    if step % scenario.replan_steps == 0:
+                        publish(objectives_publisher, encode(node.plan(step)))
+                if outcome is not None:
                     break
-                step += 1
-                node.log.errors.append(node.replica.map.domain_error())
-                if step % snapshot_steps == 0:
-                    node.take_snapshot(step * scenario.dt)
-                if node.replica.map.complete or step >= scenario.max_steps or not node.members:
-                    outcome = (step, node.replica.map.complete, step)
-                    break
-                publish(objectives_publisher, encode(node.plan(step)))
+                if node.membership_changed and node.members:
+                    # Someone left mid-block: tell the rest whom to wait for, with new targets.
+                    publish(objectives_publisher, encode(node.plan(step)))
             else:
                 item = node.inbox.get(timeout=0.01)
                 while item is not None:
@@ -228,6 +251,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                     if (len(node.log.errors) - 1) % snapshot_steps == 0:
                         node.take_snapshot((len(node.log.errors) - 1) * scenario.dt)
                 if node.replica.map.complete or reached >= scenario.max_steps or not node.members:
+                    node.log.errors[reached] = node.replica.map.domain_error()  # the map as it ends
                     outcome = (reached, node.replica.map.complete, reached)
                     break
                 now = time.monotonic()

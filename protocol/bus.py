@@ -63,6 +63,17 @@ def open_session(config: zenoh.Config, attempts: int = 40, delay: float = 0.25) 
     raise RuntimeError("unreachable")
 
 
+def team_publisher(session: zenoh.Session, key: str) -> zenoh.Publisher:
+    """A publisher for team traffic: reliable, never dropped under congestion (lockstep would
+    wait forever for a dropped delta), and express (sent at once, not batched: a step waits on it)."""
+    return session.declare_publisher(
+        key,
+        congestion_control=zenoh.CongestionControl.BLOCK,
+        reliability=zenoh.Reliability.RELIABLE,
+        express=True,
+    )
+
+
 @dataclass(frozen=True)
 class Received:
     key: str

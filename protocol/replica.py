@@ -47,6 +47,9 @@ class MapReplica:
         self.duplicates = 0
 
     def has(self, agent: int, seq: int) -> bool:
+        """Whether (agent, seq) is in the map; every agent trivially has 'step −1' (nothing)."""
+        if seq < 0:
+            return True
         sequences = self.applied.get(agent)
         return sequences is not None and sequences.contains(seq)
 

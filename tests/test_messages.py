@@ -1,0 +1,132 @@
+import math
+
+import msgpack
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from protocol.messages import (
+    PROTOCOL_VERSION,
+    AgentState,
+    Limits,
+    MapDelta,
+    Objectives,
+    ProtocolError,
+    RunControl,
+    Snapshot,
+    decode,
+    encode,
+)
+
+LIMITS = Limits(rows=100, cols=100, agents=4)
+
+
+def reason_of(payload: bytes, expected: str | None = None) -> str:
+    with pytest.raises(ProtocolError) as caught:
+        decode(payload, LIMITS, expected)
+    return caught.value.reason
+
+
+def test_delta_round_trip():
+    ticks = np.arange(12, dtype=np.int64).reshape(3, 4)
+    back = decode(encode(MapDelta(2, 17, 5, 6, ticks)), LIMITS)
+    assert isinstance(back, MapDelta)
+    assert (back.agent, back.seq, back.row0, back.col0) == (2, 17, 5, 6)
+    assert np.array_equal(back.ticks, ticks)
+
+
+def test_state_objectives_control_snapshot_round_trip():
+    state = AgentState(1, 4, (1.0, 2.0, 0.5), 0.25, -0.5, 0.75, (1.1, 2.1, 0.55))
+    assert decode(encode(state), LIMITS) == state
+    objectives = decode(
+        encode(Objectives(50, (0, 2), np.array([[1.0, 2.0], [3.0, 4.0]]), np.array([[5.0, 6.0]]))), LIMITS
+    )
+    assert objectives.members == (0, 2) and objectives.target_of(2) == (3.0, 4.0) and objectives.target_of(1) is None
+    control = RunControl("done", 6050, True, 0.0, "")
+    assert decode(encode(control), LIMITS) == control
+    coverage = np.random.default_rng(1).integers(0, 10**9, (100, 100))
+    snapshot = decode(encode(Snapshot(coverage, {0: (5, (7, 9)), 3: (-1, ())})), LIMITS)
+    assert np.array_equal(snapshot.coverage, coverage)
+    assert snapshot.applied == {0: (5, (7, 9)), 3: (-1, ())}
+
+
+def body(**fields):
+    return msgpack.packb({"v": PROTOCOL_VERSION, **fields}, use_bin_type=True)
+
+
+def good_delta(**changes):
+    fields = {
+        "type": "delta",
+        "agent": 1,
+        "seq": 3,
+        "row0": 10,
+        "col0": 10,
+        "h": 2,
+        "w": 2,
+        "ticks": np.ones(4, "<i8").tobytes(),
+    }
+    fields.update(changes)
+    return body(**fields)
+
+
+@pytest.mark.parametrize(
+    ("payload", "reason"),
+    [
+        (b"", "undecodable"),
+        (b"\xc1garbage", "undecodable"),
+        (msgpack.packb([1, 2, 3]), "not-a-map"),
+        (msgpack.packb({"v": 99, "type": "delta"}), "bad-version"),
+        (body(type="teleport"), "unknown-type"),
+        (good_delta(agent=4), "out-of-range"),
+        (good_delta(agent=-1), "out-of-range"),
+        (good_delta(agent=True), "bad-field"),
+        (good_delta(row0=99), "window-outside-grid"),
+        (good_delta(ticks=b"\x00" * 8), "bad-shape"),
+        (good_delta(ticks=np.array([1, -1, 1, 1], "<i8").tobytes()), "negative-delta"),
+        (
+            body(type="state", agent=0, step=1, pose=[0.0, math.nan, 0.0], vel=[0, 0], e_omega=0.5, next=[0, 0, 0]),
+            "not-finite",
+        ),
+        (body(type="state", agent=0, step=1, pose=[0.0, 0.0], vel=[0, 0], e_omega=0.5, next=[0, 0, 0]), "bad-shape"),
+        (body(type="state", agent=0, step=1, pose=[0, 0, 0], vel=[0, 0], e_omega=1.5, next=[0, 0, 0]), "out-of-range"),
+        (body(type="objectives", step=1, members=[0, 0], targets=[0, 0, 0, 0], blobs=[]), "out-of-range"),
+        (body(type="objectives", step=1, members=[0], targets=[0], blobs=[]), "bad-shape"),
+        (body(type="control", kind="explode", step=1, completed=False, e_d=0.0, reason=""), "bad-field"),
+        (body(type="snapshot", rows=100, cols=100, map=b"not zlib", applied=[]), "undecodable"),
+        (body(type="snapshot", rows=50, cols=100, map=b"", applied=[]), "out-of-range"),
+    ],
+)
+def test_malformed_payloads_are_rejected_with_a_reason(payload, reason):
+    assert reason_of(payload) == reason
+
+
+def test_wrong_type_where_one_is_expected():
+    assert reason_of(good_delta(), expected="snapshot") == "wrong-type"
+
+
+def test_oversized_payload_is_rejected_before_decoding():
+    assert reason_of(b"\x00" * (9 * 1024 * 1024)) == "too-large"
+
+
+@settings(max_examples=300)
+@given(st.binary(max_size=300))
+def test_random_bytes_never_escape_as_other_exceptions(payload):
+    try:
+        decode(payload, LIMITS)
+    except ProtocolError:
+        pass
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 200), st.integers(0, 255))
+def test_mutated_delta_is_either_valid_or_rejected(position, value):
+    payload = bytearray(good_delta())
+    payload[position % len(payload)] = value
+    try:
+        message = decode(bytes(payload), LIMITS)
+    except ProtocolError:
+        return
+    if isinstance(message, MapDelta):
+        assert (message.ticks >= 0).all()
+        assert message.row0 + message.ticks.shape[0] <= 100 and message.col0 + message.ticks.shape[1] <= 100

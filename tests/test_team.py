@@ -1,0 +1,123 @@
+"""The team as real processes over real Zenoh sessions on loopback: launch_team.py end to end."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+
+import pytest
+
+from tests.teamrun import (
+    ROOT,
+    anicov,
+    launcher_command,
+    processes_of,
+    run,
+    unique_team,
+    wait_for,
+    write_scenario,
+)
+
+
+def assert_same_run(engine_dir, team_dir):
+    for name in ("trajectory.csv", "summary.json"):
+        assert (engine_dir / name).read_bytes() == (team_dir / name).read_bytes(), name
+
+
+@pytest.mark.parametrize(
+    ("agents", "domain"),
+    [(1, [40.0, 40.0]), (4, [100.0, 100.0])],
+    ids=["N=1", "N=4-paper"],
+)
+def test_lockstep_over_zenoh_equals_in_process_engine_byte_for_byte(tmp_path, agents, domain):
+    config = write_scenario(tmp_path / "s.toml", domain=domain, agents=agents, seed=3)
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet")
+    assert engine.returncode == 0, engine.stderr
+    team = unique_team()
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), team=team))
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "coverage        complete" in launched.stdout
+    assert_same_run(tmp_path / "engine", tmp_path / "team")
+    counts = json.loads((tmp_path / "team" / "coordinator_counts.json").read_text())
+    assert counts["rejected"] == 0 and counts["gaps"] == 0
+    assert processes_of(team) == []
+
+
+def test_thirty_agent_processes_equal_the_engine(tmp_path):
+    config = write_scenario(tmp_path / "s.toml", domain=[50.0, 50.0], agents=30, seed=1)
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet")
+    assert engine.returncode == 0, engine.stderr
+    team = unique_team()
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), team=team), timeout=480)
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "coordinator + 30 agents" in launched.stdout
+    assert_same_run(tmp_path / "engine", tmp_path / "team")
+    assert processes_of(team) == []
+
+
+def test_realtime_clock_completes_within_15_percent_of_lockstep(tmp_path):
+    engine = anicov("run", "--n", "4", "--seed", "0", "--out", str(tmp_path / "l"), "--quiet")
+    assert engine.returncode == 0, engine.stderr
+    lockstep = json.loads((tmp_path / "l" / "summary.json").read_text())
+    launched = run(
+        launcher_command(
+            "--n", "4", "--seed", "0", "--clock", "realtime", "--speed", "20", "--out", str(tmp_path / "rt")
+        ),
+        timeout=400,
+    )
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    summary = json.loads((tmp_path / "rt" / "summary.json").read_text())
+    assert summary["completed"] is True and summary["final_error"] == 0.0
+    ratio = summary["completion_time"] / lockstep["completion_time"]
+    assert 0.85 <= ratio <= 1.15, ratio
+    assert (tmp_path / "rt" / "trajectory.csv").read_text().startswith("t,agent,x,y,theta,v,omega\n")
+
+
+@pytest.mark.parametrize(("number", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"])
+def test_signal_stops_every_child_and_exits_with_its_code(tmp_path, number, code):
+    team = unique_team()
+    process = subprocess.Popen(
+        launcher_command("--n", "3", "--out", str(tmp_path / "run"), team=team),
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        # Wait until the team is really running: all three agents logged their start.
+        logs = tmp_path / "run" / "logs"
+        assert wait_for(
+            lambda: all(
+                (logs / f"agent-{i}.log").exists() and "starts" in (logs / f"agent-{i}.log").read_text()
+                for i in range(3)
+            ),
+            timeout=120,
+        )
+        assert len(processes_of(team)) >= 4
+        process.send_signal(number)
+        _, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == code, stderr
+    assert "every child stopped" in stderr
+    assert wait_for(lambda: processes_of(team) == [], timeout=10), processes_of(team)
+
+
+def test_busy_router_port_is_a_clear_error(tmp_path):
+    import socket
+
+    with socket.socket() as holder:
+        holder.bind(("127.0.0.1", 0))
+        holder.listen()
+        port = holder.getsockname()[1]
+        done = run(launcher_command("--n", "1", "--out", str(tmp_path), port=port), timeout=60)
+    assert done.returncode == 2
+    assert f"cannot open the router on tcp/127.0.0.1:{port}" in done.stderr
+
+
+def test_agent_with_bad_id_fails_with_a_clear_message():
+    done = anicov("agent", "--id", "7", "--n", "4", "--connect", "tcp/127.0.0.1:1", "--team", "x", timeout=60)
+    assert done.returncode == 2
+    assert "--id: expected an agent id from 0 to 3, got 7" in done.stderr
