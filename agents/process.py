@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import zenoh
 
+from agents.parameters import initial_poses, law_parameters
 from agents.robot import Robot, SimulatedUnicycle
 from agents.step import LawParameters, decide_and_sense
-from anicov.engine import initial_poses, law_parameters
 from anicov.lifecycle import EXIT_FAILED, EXIT_OK, StopFlag, parent_is_gone
 from anicov.scenario import Scenario
 from protocol.bus import Inbox, Membership, Received, team_publisher, write_counts
@@ -194,7 +194,8 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
     parent = os.getppid()
     keys = node.keys
     with zenoh.open(config) as session:
-        session.declare_subscriber(keys.all_deltas, node.inbox.on_sample)
+        # Remote only: our own deltas are applied when made, an echo would only cost a decode.
+        session.declare_subscriber(keys.all_deltas, node.inbox.on_sample, allowed_origin=zenoh.Locality.REMOTE)
         session.declare_subscriber(keys.objectives, node.inbox.on_sample)
         session.declare_subscriber(keys.control, node.inbox.on_sample)
         delta_publisher = team_publisher(session, keys.agent_delta(options.agent))

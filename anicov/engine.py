@@ -21,6 +21,7 @@ import numpy as np
 from numba import njit
 from numba.typed import List
 
+from agents.parameters import initial_poses, law_parameters
 from agents.step import LawParameters, decide_and_sense, move, sense_only
 from agents.zigzag import WaypointPilot, lane_offsets, split_lanes, zigzag_waypoints
 from anicov.metrics import coverage_distance
@@ -34,33 +35,6 @@ TRACE_FIELDS = ("x", "y", "theta", "v", "omega", "e_omega")
 
 SNAPSHOT_PERIOD = 5.0
 """Time between stored lack-of-coverage snapshots (for Fig. 6 and the recording)."""
-
-
-def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParameters:
-    """The control and sensing parameters of a scenario."""
-    return LawParameters(
-        sensing_range=scenario.range,
-        half_angle=scenario.half_angle,
-        alpha_max=scenario.alpha_max,
-        beta=scenario.beta,
-        k_v=scenario.k_v,
-        k_omega=scenario.k_omega,
-        dt=scenario.dt,
-        cell=scenario.cell,
-        target_ticks=coverage_map.target_ticks,
-        literal_heading=scenario.controller == "paper-literal",
-        literal_omega=scenario.controller == "paper-literal",
-    )
-
-
-def initial_poses(scenario: Scenario) -> np.ndarray:
-    """Poses (N, 3) drawn uniformly in the domain and in (−π, π] from the scenario's seed."""
-    rng = np.random.default_rng(scenario.seed)
-    width, height = scenario.domain
-    x = rng.uniform(0.0, width, scenario.agents)
-    y = rng.uniform(0.0, height, scenario.agents)
-    theta = rng.uniform(-math.pi, math.pi, scenario.agents)
-    return np.stack([x, y, theta], axis=1)
 
 
 @dataclass

@@ -134,8 +134,8 @@ def warm_numba_cache() -> None:
     """Compile (or load) the jitted kernels once here, so N children do not all compile at once."""
     import numpy as np
 
+    from agents.parameters import law_parameters
     from agents.step import decide_and_sense, move
-    from anicov.engine import law_parameters
     from anicov.scenario import Scenario
     from protocol.coverage_map import CoverageMap, add_window
 

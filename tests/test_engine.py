@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from anicov.engine import TRACE_FIELDS, initial_poses, run_scenario
+from agents.parameters import initial_poses
+from anicov.engine import TRACE_FIELDS, run_scenario
 from anicov.metrics import optimum_time, total_sensing_ability
 
 
