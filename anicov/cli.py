@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import shutil
+import subprocess
 import sys
 import time
+import uuid
 from pathlib import Path
 
 from anicov.scenario import CONTROLLERS, Scenario, ScenarioError, load_scenario
@@ -43,9 +46,57 @@ def command_run(args: argparse.Namespace) -> int:
     summary = summary_of(result)
     write_summary(summary, out_dir / "summary.json")
     write_run_plots(result, out_dir)
+    if not args.no_record:
+        from anicov.recording import record_result
+
+        record_result(
+            result, out_dir / "recording.rrd", recording_id=f"run-{uuid.uuid4().hex[:12]}", map_every=args.map_every
+        )
+        if args.viewer:
+            open_viewer(out_dir / "recording.rrd")
     print(format_summary(summary, out_dir))
     print(f"  wall time       {time.perf_counter() - started:.1f} s")
     return EXIT_OK if result.completed else EXIT_INCOMPLETE
+
+
+def open_viewer(path: Path) -> None:
+    """Open a recording in the rerun viewer (the one shipped with rerun-sdk)."""
+    viewer = shutil.which("rerun") or str(Path(sys.executable).parent / "rerun")
+    subprocess.Popen([viewer, str(path)], start_new_session=True)
+
+
+def command_replay(args: argparse.Namespace) -> int:
+    path = Path(args.recording)
+    if not path.is_file():
+        raise ScenarioError(f"replay: no recording at {path}")
+    if args.summary:
+        from anicov.replay import format_recording_summary, summarise_recording
+
+        print(format_recording_summary(summarise_recording(path)))
+        return EXIT_OK
+    open_viewer(path)
+    return EXIT_OK
+
+
+def command_logger(args: argparse.Namespace) -> int:
+    from anicov.lifecycle import StopFlag, setup_logging
+    from anicov.logger import LoggerOptions, run_logger
+    from protocol.bus import zenoh_config
+
+    setup_logging("logger", args.verbose)
+    stop = StopFlag().install()
+    scenario = _process_scenario(args)
+    options = LoggerOptions(
+        args.team,
+        args.recording_id or f"{args.team}-{uuid.uuid4().hex[:12]}",
+        None if args.no_record else args.out,
+        args.viewer,
+        args.serve,
+        args.map_every,
+        args.counts,
+    )
+    config = zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
+    return run_logger(scenario, options, config, stop)
 
 
 def command_reproduce(args: argparse.Namespace) -> int:
@@ -138,7 +189,26 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--controller", choices=CONTROLLERS, help="overrides 'controller'")
     run.add_argument("--out", required=True, help="output directory")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
+    run.add_argument("--no-record", action="store_true", help="do not write OUT/recording.rrd")
+    run.add_argument("--viewer", action="store_true", help="open the recording in the rerun viewer afterwards")
+    run.add_argument("--map-every", type=int, default=50, help="log the map every K steps (default 50)")
     run.set_defaults(handler=command_run)
+
+    replay = commands.add_parser("replay", help="open a recording in the viewer, or summarise it (--summary)")
+    replay.add_argument("recording", help="a .rrd file written by a run")
+    replay.add_argument("--summary", action="store_true", help="print what it holds, headless")
+    replay.set_defaults(handler=command_replay)
+
+    logger = commands.add_parser("logger", help="record a team over the bus into a rerun recording")
+    logger.add_argument("--out", default="recording.rrd", help="recording file (default recording.rrd)")
+    logger.add_argument("--recording-id", help="share one recording id with other loggers of the run")
+    logger.add_argument("--no-record", action="store_true", help="no file (only a live viewer)")
+    logger.add_argument("--viewer", action="store_true", help="spawn a live rerun viewer")
+    logger.add_argument("--serve", action="store_true", help="serve a web viewer for a remote browser")
+    logger.add_argument("--map-every", type=int, default=50, help="log the map every K steps (default 50)")
+    logger.add_argument("--counts", help="write message counters to this JSON file at exit")
+    _add_process_arguments(logger)
+    logger.set_defaults(handler=command_logger)
 
     reproduce = commands.add_parser("reproduce", help="the paper's experiments (Fig. 7–10) with a table and plots")
     reproduce.add_argument("--out", required=True, help="output directory")

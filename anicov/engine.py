@@ -55,6 +55,11 @@ class Planner:
             objectives = fallback[None, :]
         return objectives[assign_objectives(positions, objectives)]
 
+    def record(self, step: int, targets: np.ndarray) -> Plan:
+        """This plan as kept for the recording: members are all agents, in id order."""
+        labels = None if self.blobs.labels is None else self.blobs.labels.astype(np.uint16)
+        return (step, tuple(range(len(targets))), targets.copy(), self.blobs.positions.copy(), labels)
+
 
 @njit(cache=True)
 def advance_team(
@@ -118,12 +123,16 @@ class RunResult:
     snapshots: list[np.ndarray]  # Υ as uint8 (0 = covered, 255 = untouched)
     final_lack: np.ndarray
     plan_time: float | None = None  # zig-zag only: when the last lane was finished
+    plans: list[Plan] = field(default_factory=list)  # every replan, for the recording
 
     @property
     def path_lengths(self) -> np.ndarray:
         """Σ |v| dt per agent (steps whose state was never heard, NaN in a realtime trace, count as 0)."""
         return np.nansum(np.abs(self.trace[:-1, :, 3]), axis=0) * self.scenario.dt
 
+
+Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
+"""(step, members, targets (N, 2), blob objectives Ψ (M, 2), blob labels of the grid or None)."""
 
 ProgressCallback = Callable[[float, float], None]
 """Called as progress(sim_time, e_D) after each block of steps."""
@@ -155,10 +164,13 @@ def run_scenario(
     scratch_trace = np.zeros((block, agents, len(TRACE_FIELDS)))
     scratch_errors = np.zeros(block)
     steps_done = 0
+    plans: list[Plan] = []
     next_snapshot = SNAPSHOT_PERIOD
     while steps_done < scenario.max_steps and not coverage_map.complete:
         lack = coverage_map.lack_of_coverage()
         objectives = planner.plan(lack, poses[:, :2])
+        if record_trace:
+            plans.append(planner.record(steps_done, objectives))
         steps = min(block, scenario.max_steps - steps_done)
         done, coverage_map.uncovered_cells, coverage_map.deficit_ticks = advance_team(
             coverage_map.coverage,
@@ -184,7 +196,9 @@ def run_scenario(
             next_snapshot += SNAPSHOT_PERIOD
         if progress is not None:
             progress(now, coverage_map.domain_error())
-    return _finish(scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace)
+    result = _finish(scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace)
+    result.plans = plans
+    return result
 
 
 def _finish(

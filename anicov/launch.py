@@ -69,6 +69,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--team", default="team", help="team name: keys live under anicov/<team>/")
     parser.add_argument("--out", help="run directory (default runs/<date-time>)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--no-record", action="store_true", help="no logger, no OUT/recording.rrd")
+    parser.add_argument("--viewer", action="store_true", help="spawn a live rerun viewer")
+    parser.add_argument("--serve", action="store_true", help="serve a web viewer (for a browser on another machine)")
+    parser.add_argument("--map-every", type=int, default=50, help="log the map every K steps (default 50)")
     return parser
 
 
@@ -128,6 +132,26 @@ def stop_children(children: list[Child], grace: float = GRACE_SECONDS) -> None:
             log.warning("%s did not stop in %.0f s; killing it", child.role, grace)
             child.process.kill()
             child.process.wait()
+
+
+def wait_for_exit(children: list[Child], timeout: float) -> None:
+    deadline = time.monotonic() + timeout
+    for child in children:
+        try:
+            child.process.wait(timeout=max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            pass
+
+
+def wait_for_token(session, key: str, timeout: float) -> bool:
+    """Wait until a liveliness token is declared (a child is up and subscribed)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if any(reply.ok is not None for reply in session.liveliness().get(key, timeout=0.5)):
+            return True
+        time.sleep(0.1)
+    log.warning("%s did not appear in %.0f s", key, timeout)
+    return False
 
 
 def warm_numba_cache() -> None:
@@ -198,6 +222,19 @@ def main(argv: list[str] | None = None) -> int:
         router.declare_subscriber(keys.control, on_control)
         router.declare_subscriber(keys.status, on_control)
         children.append(spawn("coordinator", child_command("coordinator", args, ["--out", str(out_dir)]), logs))
+        if not args.no_record or args.viewer or args.serve:
+            logger_flags = [
+                "--out",
+                str(out_dir / "recording.rrd"),
+                "--map-every",
+                str(args.map_every),
+                "--recording-id",
+                f"{args.team}-{out_dir.name}",
+            ]
+            logger_flags += ["--no-record"] * args.no_record + ["--viewer"] * args.viewer + ["--serve"] * args.serve
+            children.append(spawn("logger", child_command("logger", args, logger_flags), logs))
+            # The logger subscribes before the agents start, so it sees the run from step 0.
+            wait_for_token(router, keys.alive("logger"), timeout=60.0)
         for agent in range(scenario.agents):
             children.append(spawn(f"agent-{agent}", child_command("agent", args, ["--id", str(agent)]), logs))
         bar = tqdm(total=100, desc=f"team of {scenario.agents}", unit="%", disable=args.quiet or None)
@@ -222,6 +259,9 @@ def main(argv: list[str] | None = None) -> int:
                 stop.event.wait(0.1)
         finally:
             bar.close()
+            if not stop.stopped:
+                # After the end of the run every child leaves by itself (the logger flushes first).
+                wait_for_exit(children, GRACE_SECONDS)
             stop_children(children)
     if stop.stopped:
         print(f"launch_team: stopped by signal; every child stopped. Logs in {logs}", file=sys.stderr)
@@ -232,7 +272,13 @@ def main(argv: list[str] | None = None) -> int:
 
         summary = json.loads(summary_path.read_text())
         print(format_summary(summary, out_dir).replace("anicov run:", f"launch_team ({args.clock}, over Zenoh):"))
-        print(f"  processes       coordinator + {scenario.agents} agents, logs in {logs}")
+        print(
+            f"  processes       coordinator + {scenario.agents} agents"
+            + ("" if args.no_record else " + logger")
+            + f", logs in {logs}"
+        )
+        if (out_dir / "recording.rrd").exists():
+            print(f"  recording       {out_dir / 'recording.rrd'}   (anicov replay {out_dir / 'recording.rrd'})")
         print(f"  wall time       {time.monotonic() - started:.1f} s")
         return EXIT_OK if summary["completed"] else EXIT_INCOMPLETE
     print(f"launch_team: the run failed (exit {exit_code}); logs in {logs}", file=sys.stderr)

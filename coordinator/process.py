@@ -133,6 +133,14 @@ class Coordinator:
         ):
             self.targets = self.planner.plan(self.replica.map.lack_of_coverage(), positions)
             self.membership_changed = False
+            labels = self.planner.blobs.labels
+            return Objectives(
+                step,
+                tuple(members),
+                self.targets,
+                self.planner.blobs.positions,
+                None if labels is None else labels.astype(np.uint16),
+            )
         return Objectives(step, tuple(members), self.targets, self.planner.blobs.positions)
 
     def step_complete(self, step: int) -> bool:
@@ -260,7 +268,11 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                     objectives = node.plan(0)  # as step 0 of a block: replan on every wall-clock period
                     publish(
                         objectives_publisher,
-                        encode(Objectives(step, objectives.members, objectives.targets, objectives.blobs)),
+                        encode(
+                            Objectives(
+                                step, objectives.members, objectives.targets, objectives.blobs, objectives.labels
+                            )
+                        ),
                     )
                     next_plan = now + scenario.replan_period / options.speed
             now = time.monotonic()
@@ -289,12 +301,13 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             "wall_seconds": time.monotonic() - started,
             "events": node.log.events,
         }
+        if outcome is not None and options.out:
+            # Still on the bus while writing: a late logger can fetch the final map's snapshot.
+            steps, completed, completion_step = outcome
+            write_run_directory(node.result(steps, completed, completion_step), Path(options.out), counts)
     if outcome is None:
         return stop.exit_code(EXIT_FAILED)
-    steps, completed, completion_step = outcome
-    if options.out:
-        write_run_directory(node.result(steps, completed, completion_step), Path(options.out), counts)
-    return EXIT_OK if completed else EXIT_INCOMPLETE
+    return EXIT_OK if outcome[1] else EXIT_INCOMPLETE
 
 
 def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, object]) -> None:

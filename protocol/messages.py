@@ -75,6 +75,7 @@ class Objectives:
     members: tuple[int, ...]
     targets: np.ndarray  # (len(members), 2): target of members[i]
     blobs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # Ψ of Alg. 1
+    labels: np.ndarray | None = None  # uint16 (rows, cols): blob π_j of each cell, 0 = none (for the logger)
 
     def target_of(self, agent: int) -> tuple[float, float] | None:
         if agent not in self.members:
@@ -139,15 +140,15 @@ def encode(message: Message) -> bytes:
             },
         )
     if isinstance(message, Objectives):
-        return _pack(
-            "objectives",
-            {
-                "step": message.step,
-                "members": list(message.members),
-                "targets": np.asarray(message.targets, float).ravel().tolist(),
-                "blobs": np.asarray(message.blobs, float).ravel().tolist(),
-            },
-        )
+        body = {
+            "step": message.step,
+            "members": list(message.members),
+            "targets": np.asarray(message.targets, float).ravel().tolist(),
+            "blobs": np.asarray(message.blobs, float).ravel().tolist(),
+        }
+        if message.labels is not None:
+            body["labels"] = zlib.compress(np.ascontiguousarray(message.labels, dtype="<u2").tobytes(), 1)
+        return _pack("objectives", body)
     if isinstance(message, RunControl):
         return _pack(
             "control",
@@ -218,6 +219,19 @@ def _header(payload: bytes) -> dict[str, Any]:
 MAX_STEP = 2**40
 
 
+def _inflate(packed: Any, size: int, name: str) -> bytes:
+    """Decompress a zlib field that must hold exactly ``size`` bytes (and never inflates past it)."""
+    if not isinstance(packed, bytes):
+        raise ProtocolError("bad-field", f"{name} must be bytes")
+    try:
+        raw = zlib.decompressobj().decompress(packed, size + 1)
+    except zlib.error:
+        raise ProtocolError("undecodable", f"{name} is not zlib data") from None
+    if len(raw) != size:
+        raise ProtocolError("bad-shape", f"{name} must hold {size} bytes")
+    return raw
+
+
 def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Message:
     """Decode and validate one payload; raise ProtocolError (with ``.reason``) if it is not acceptable."""
     body = _header(payload)
@@ -268,7 +282,15 @@ def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Messa
         blobs = _floats(body, "blobs")
         if len(blobs) % 2:
             raise ProtocolError("bad-shape", "blobs must hold (x, y) pairs")
-        return Objectives(step, tuple(members), np.array(targets).reshape(-1, 2), np.array(blobs).reshape(-1, 2))
+        labels = None
+        if body.get("labels") is not None:
+            raw = _inflate(body["labels"], 2 * limits.rows * limits.cols, "labels")
+            labels = np.frombuffer(raw, dtype="<u2").reshape(limits.rows, limits.cols).astype(np.uint16)
+            if labels.max(initial=0) > len(blobs) // 2:
+                raise ProtocolError("out-of-range", "labels name a blob that does not exist")
+        return Objectives(
+            step, tuple(members), np.array(targets).reshape(-1, 2), np.array(blobs).reshape(-1, 2), labels
+        )
     if kind == "control":
         control_kind = body.get("kind")
         if control_kind not in RUN_CONTROL_KINDS:
@@ -283,15 +305,7 @@ def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Messa
     if kind == "snapshot":
         rows = _int(body, "rows", limits.rows, limits.rows)
         cols = _int(body, "cols", limits.cols, limits.cols)
-        packed = body.get("map")
-        if not isinstance(packed, bytes):
-            raise ProtocolError("bad-field", "map must be bytes")
-        try:
-            raw = zlib.decompressobj().decompress(packed, 8 * rows * cols + 1)
-        except zlib.error:
-            raise ProtocolError("undecodable", "map is not zlib data") from None
-        if len(raw) != 8 * rows * cols:
-            raise ProtocolError("bad-shape", "map must hold rows*cols int64")
+        raw = _inflate(body.get("map"), 8 * rows * cols, "map")
         coverage = np.frombuffer(raw, dtype="<i8").reshape(rows, cols).astype(np.int64)
         if (coverage < 0).any():
             raise ProtocolError("negative-delta", "map cells must be non-negative")

@@ -1,0 +1,148 @@
+"""The logger process: subscribes to the whole team and writes its rerun recording.
+
+It keeps its own replica of the map (so a late start still ends with the full
+map: it loads the coordinator's snapshot first), logs every agent's state,
+the objectives and blobs, e_D, and the team's events, and flushes the
+recording when the run ends or when it is stopped.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import zenoh
+
+from anicov.lifecycle import EXIT_OK, StopFlag, parent_is_gone
+from anicov.recording import RunRecorder
+from anicov.scenario import Scenario
+from protocol.bus import Inbox, Membership, Received, write_counts
+from protocol.keys import TeamKeys
+from protocol.messages import AgentState, Limits, MapDelta, Objectives, ProtocolError, RunControl, Snapshot, decode
+from protocol.replica import MapReplica
+
+log = logging.getLogger("anicov.logger")
+
+FLUSH_PERIOD = 0.5
+"""Seconds between sends of the buffered per-step columns."""
+
+
+@dataclass
+class LoggerOptions:
+    team: str
+    recording_id: str
+    path: str | None
+    spawn_viewer: bool = False
+    serve_web: bool = False
+    map_every: int = 50
+    counts_file: str | None = None
+
+
+class TeamLogger:
+    def __init__(self, scenario: Scenario, options: LoggerOptions) -> None:
+        self.scenario = scenario
+        rows, cols = scenario.grid_shape
+        self.limits = Limits(rows, cols, scenario.agents)
+        self.replica = MapReplica(rows, cols, scenario.cell, scenario.lambda_star)
+        self.inbox = Inbox(self.limits)
+        self.recorder = RunRecorder(
+            scenario,
+            options.recording_id,
+            Path(options.path) if options.path else None,
+            options.spawn_viewer,
+            options.serve_web,
+            options.map_every,
+        )
+        self.positions = np.full((scenario.agents, 2), np.nan)
+        self.latest_step = -1
+        self.logged_map_step = -1
+        self.finished: RunControl | None = None
+
+    def handle(self, item: Received | Membership) -> None:
+        if isinstance(item, Membership):
+            self.recorder.event(
+                max(self.latest_step, 0),
+                f"agent {item.agent} {'joined' if item.alive else 'left'}",
+                "INFO" if item.alive else "WARN",
+            )
+            return
+        message = item.message
+        if isinstance(message, MapDelta):
+            self.replica.apply(message)
+        elif isinstance(message, AgentState):
+            if message.step >= 0:
+                self.recorder.state(
+                    message.agent, message.step, *message.pose, message.v, message.omega, message.e_omega
+                )
+            self.positions[message.agent] = message.next_pose[:2]
+            if message.step + 1 > self.latest_step:
+                self.latest_step = message.step + 1
+                self.recorder.domain_error(self.latest_step, self.replica.map.domain_error())
+                if self.latest_step % self.recorder.map_every == 0:
+                    self.recorder.lack_map(self.latest_step, self.replica.map.lack_of_coverage())
+        elif isinstance(message, Objectives):
+            self.recorder.objectives(
+                message.step, self.positions, message.members, message.targets, message.blobs, message.labels
+            )
+        elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
+            self.finished = message
+
+    def load_snapshot(self, session: zenoh.Session, keys: TeamKeys) -> None:
+        """A late logger starts from the coordinator's map."""
+        for reply in session.get(keys.snapshot, timeout=2.0):
+            if reply.ok is None:
+                continue
+            try:
+                snapshot = decode(reply.ok.payload.to_bytes(), self.limits, expected="snapshot")
+            except ProtocolError as error:
+                log.warning("snapshot rejected: %s", error)
+                continue
+            assert isinstance(snapshot, Snapshot)
+            self.replica.load(snapshot)
+            log.info("loaded the coordinator's snapshot (e_D = %.4f)", self.replica.map.domain_error())
+
+    def finish(self) -> None:
+        """The run's final map and its end, then flush everything to the sinks."""
+        final_step = self.finished.step if self.finished is not None else max(self.latest_step, 0)
+        self.recorder.lack_map(final_step, self.replica.map.lack_of_coverage())
+        self.recorder.domain_error(final_step, self.replica.map.domain_error())
+        if self.finished is not None:
+            text = "run complete" if self.finished.completed else f"run ended: {self.finished.reason or 'incomplete'}"
+        else:
+            text = "logger stopped before the end of the run"
+        self.recorder.event(final_step, text)
+        self.recorder.close()
+
+
+def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config, stop: StopFlag) -> int:
+    node = TeamLogger(scenario, options)
+    keys = TeamKeys(options.team)
+    parent = os.getppid()
+    with zenoh.open(config) as session:
+        for key in (keys.all_deltas, keys.all_states, keys.objectives, keys.control):
+            session.declare_subscriber(key, node.inbox.on_sample)
+        session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
+        token = session.liveliness().declare_token(keys.alive("logger"))
+        node.load_snapshot(session, keys)
+        next_flush = time.monotonic() + FLUSH_PERIOD
+        while node.finished is None and not stop.stopped and not parent_is_gone(parent):
+            item = node.inbox.get(timeout=0.1)
+            if item is not None:
+                node.handle(item)
+            if time.monotonic() >= next_flush:
+                node.recorder.flush_states()
+                next_flush = time.monotonic() + FLUSH_PERIOD
+        # Drain what is already here (the last deltas travel beside the end-of-run message).
+        deadline = time.monotonic() + 0.5
+        while time.monotonic() < deadline and (item := node.inbox.get(timeout=0.05)) is not None:
+            node.handle(item)
+        if node.finished is not None and not node.replica.map.complete:
+            node.load_snapshot(session, keys)  # anything lost on the way: the coordinator's map is the reference
+        token.undeclare()
+    node.finish()
+    write_counts(Path(options.counts_file) if options.counts_file else None, node.inbox.counts())
+    return stop.exit_code(EXIT_OK)

@@ -1,0 +1,240 @@
+"""Rerun recordings of a run: the map, the agents, the blobs, the errors, the events.
+
+One :class:`RunRecorder` serves both the logger process (live, message by
+message) and ``anicov run`` (after the run, from its result), so a recording
+looks the same however the run was made. Entity tree, in the map view's cell
+units with y pointing up (x/cell, rows − y/cell):
+
+    world/domain                       LineStrips2D   the domain outline
+    world/map/lack_of_coverage         Image (f32)    Υ (eq. 4): white = uncovered, black = covered
+    world/blobs/segmentation           SegmentationImage  blob π_j of each cell (Alg. 1)
+    world/blobs/objectives             Points2D       Ψ (Alg. 1)
+    world/agents/<i>/position          Points2D       labelled "agent i"
+    world/agents/<i>/heading           Arrows2D
+    world/agents/<i>/wedge             LineStrips2D   the camera's footprint (eq. 2)
+    world/agents/<i>/trail             LineStrips2D   the last TRAIL_STEPS of its path
+    world/agents/<i>/objective         LineStrips2D   agent → its objective (Alg. 2)
+    metrics/e_D                        Scalars        eq. 5 (Fig. 4)
+    agents/<i>/e_omega, v, omega       Scalars        eq. 6, 15, 16 (Fig. 5)
+    run/scenario                       TextDocument   scenario, seed, team size (static)
+    run/events                         TextLog        joined, left, done
+
+Timelines: ``step`` (sequence) and ``sim_time`` (duration, one second per
+simulated time unit).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from pathlib import Path
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from anicov.scenario import Scenario
+
+APPLICATION_ID = "anicov"
+TRAIL_STEPS = 500
+"""Steps of path shown behind each agent (subsampled at the map decimation)."""
+WEDGE_ARC_POINTS = 9
+
+
+def default_blueprint(agents: int) -> rrb.Blueprint:
+    """The map view beside the time series of Fig. 4 and 5."""
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Spatial2DView(origin="/world", name="Coverage map"),
+            rrb.Vertical(
+                rrb.TimeSeriesView(origin="/metrics", name="e_D (Fig. 4)"),
+                rrb.TimeSeriesView(origin="/agents", contents="/agents/*/v", name="v per agent (Fig. 5)"),
+                rrb.TimeSeriesView(origin="/agents", contents="/agents/*/omega", name="ω per agent (Fig. 5)"),
+                rrb.TimeSeriesView(origin="/agents", contents="/agents/*/e_omega", name="e_Ω per agent"),
+            ),
+            column_shares=[3, 2],
+        ),
+        rrb.TimePanel(expanded=False),
+        collapse_panels=agents > 50,
+    )
+
+
+class RunRecorder:
+    """Writes one run to a rerun recording (a file, a live viewer, or both)."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        recording_id: str,
+        path: Path | None = None,
+        spawn_viewer: bool = False,
+        serve_web: bool = False,
+        map_every: int = 50,
+    ) -> None:
+        self.scenario = scenario
+        self.rows, self.cols = scenario.grid_shape
+        self.map_every = max(1, map_every)
+        self.stream = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id, send_properties=False)
+        sinks: list = []
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            sinks.append(rr.FileSink(str(path)))
+        if serve_web:
+            uri = self.stream.serve_grpc()
+            rr.serve_web_viewer(connect_to=uri, open_browser=False)
+            print(f"rerun web viewer: http://localhost:9090/?url={uri}", flush=True)
+        if spawn_viewer:
+            self.stream.spawn(connect=False)
+            sinks.append(rr.GrpcSink())
+        if sinks:
+            self.stream.set_sinks(*sinks)
+        self.stream.send_blueprint(default_blueprint(scenario.agents))
+        self._trails: list[deque[tuple[float, float]]] = [
+            deque(maxlen=TRAIL_STEPS // self.map_every + 1) for _ in range(scenario.agents)
+        ]
+        self._pending: dict[int, list[tuple[int, float, float, float, float, float, float]]] = {}
+        self._log_static()
+
+    # -------------------------------------------------------------- helpers
+
+    def to_view(self, x: np.ndarray | float, y: np.ndarray | float) -> np.ndarray:
+        """World (x, y) → map view coordinates (cells, y up)."""
+        return np.stack([np.asarray(x) / self.scenario.cell, self.rows - np.asarray(y) / self.scenario.cell], axis=-1)
+
+    def _at(self, step: int) -> None:
+        self.stream.set_time("step", sequence=step)
+        self.stream.set_time("sim_time", duration=step * self.scenario.dt)
+
+    def _log_static(self) -> None:
+        width, height = self.scenario.domain
+        corners = self.to_view(np.array([0, width, width, 0, 0]), np.array([0, 0, height, height, 0]))
+        self.stream.log("world/domain", rr.LineStrips2D([corners], colors=[(80, 80, 255)]), static=True)
+        lines = [f"- **{key}**: {value}" for key, value in self.scenario.to_dict().items()]
+        self.stream.log(
+            "run/scenario", rr.TextDocument("\n".join(["# Scenario", *lines]), media_type="text/markdown"), static=True
+        )
+        for agent in range(self.scenario.agents):
+            for name in ("v", "omega", "e_omega"):
+                self.stream.log(f"agents/{agent}/{name}", rr.SeriesLines(names=f"agent {agent}"), static=True)
+
+    def wedge(self, x: float, y: float, theta: float) -> np.ndarray:
+        """Outline of the camera footprint of eq. 2: apex, arc of radius R over ±F, back to the apex."""
+        angles = np.linspace(theta - self.scenario.half_angle, theta + self.scenario.half_angle, WEDGE_ARC_POINTS)
+        xs = np.concatenate([[x], x + self.scenario.range * np.cos(angles), [x]])
+        ys = np.concatenate([[y], y + self.scenario.range * np.sin(angles), [y]])
+        return self.to_view(xs, ys)
+
+    # -------------------------------------------------------------- logging
+
+    def event(self, step: int, text: str, level: str = "INFO") -> None:
+        self._at(step)
+        self.stream.log("run/events", rr.TextLog(text, level=level))
+
+    def state(
+        self, agent: int, step: int, x: float, y: float, theta: float, v: float, omega: float, e_omega: float
+    ) -> None:
+        """One agent's step; buffered and sent in columns (cheap), drawn fully on map steps."""
+        self._pending.setdefault(agent, []).append((step, x, y, theta, v, omega, e_omega))
+        if step % self.map_every == 0:
+            self._trails[agent].append((x, y))
+            self._at(step)
+            trail = np.array(self._trails[agent])
+            self.stream.log(f"world/agents/{agent}/wedge", rr.LineStrips2D([self.wedge(x, y, theta)]))
+            self.stream.log(f"world/agents/{agent}/trail", rr.LineStrips2D([self.to_view(trail[:, 0], trail[:, 1])]))
+
+    def flush_states(self) -> None:
+        """Send the buffered per-step poses and series as columns."""
+        for agent, rows in self._pending.items():
+            if not rows:
+                continue
+            data = np.array(rows)
+            steps = data[:, 0].astype(np.int64)
+            indexes = [
+                rr.TimeColumn("step", sequence=steps),
+                rr.TimeColumn("sim_time", duration=steps * self.scenario.dt),
+            ]
+            view = self.to_view(data[:, 1], data[:, 2])
+            label = f"agent {agent}"
+            self.stream.send_columns(
+                f"world/agents/{agent}/position",
+                indexes=indexes,
+                columns=rr.Points2D.columns(positions=view, labels=[label] * len(steps)),
+            )
+            heading = np.stack([np.cos(data[:, 3]), -np.sin(data[:, 3])], axis=1) * 4.0 / self.scenario.cell
+            self.stream.send_columns(
+                f"world/agents/{agent}/heading",
+                indexes=indexes,
+                columns=rr.Arrows2D.columns(origins=view, vectors=heading),
+            )
+            for column, name in ((4, "v"), (5, "omega"), (6, "e_omega")):
+                self.stream.send_columns(
+                    f"agents/{agent}/{name}", indexes=indexes, columns=rr.Scalars.columns(scalars=data[:, column])
+                )
+        self._pending = {}
+
+    def domain_error(self, step: int, value: float) -> None:
+        self._at(step)
+        self.stream.log("metrics/e_D", rr.Scalars(value))
+
+    def domain_errors(self, errors: np.ndarray) -> None:
+        steps = np.arange(len(errors), dtype=np.int64)
+        self.stream.send_columns(
+            "metrics/e_D",
+            indexes=[
+                rr.TimeColumn("step", sequence=steps),
+                rr.TimeColumn("sim_time", duration=steps * self.scenario.dt),
+            ],
+            columns=rr.Scalars.columns(scalars=errors),
+        )
+
+    def lack_map(self, step: int, lack: np.ndarray) -> None:
+        """Υ over the grid, flipped so that y points up in the view."""
+        self._at(step)
+        self.stream.log("world/map/lack_of_coverage", rr.Image(np.flipud(lack).astype(np.float32), color_model="L"))
+
+    def objectives(
+        self,
+        step: int,
+        positions: np.ndarray,
+        members: tuple[int, ...],
+        targets: np.ndarray,
+        blobs: np.ndarray,
+        labels: np.ndarray | None,
+    ) -> None:
+        self._at(step)
+        if len(blobs):
+            self.stream.log(
+                "world/blobs/objectives",
+                rr.Points2D(self.to_view(blobs[:, 0], blobs[:, 1]), radii=1.2, colors=[(255, 160, 0)]),
+            )
+        if labels is not None:
+            self.stream.log("world/blobs/segmentation", rr.SegmentationImage(np.flipud(labels)))
+        for agent, target in zip(members, targets, strict=True):
+            if agent < len(positions) and not math.isnan(positions[agent][0]):
+                segment = self.to_view(
+                    np.array([positions[agent][0], target[0]]), np.array([positions[agent][1], target[1]])
+                )
+                self.stream.log(f"world/agents/{agent}/objective", rr.LineStrips2D([segment], colors=[(255, 160, 0)]))
+
+    def close(self) -> None:
+        self.flush_states()
+        self.stream.flush()
+        self.stream.disconnect()
+
+
+def record_result(result, path: Path, recording_id: str, map_every: int = 50) -> None:
+    """Write a finished in-process run (``anicov run``) as a recording."""
+    recorder = RunRecorder(result.scenario, recording_id, path=path, map_every=map_every)
+    trace = result.trace
+    for step in range(len(trace) - 1):
+        for agent in range(result.scenario.agents):
+            recorder.state(agent, step, *trace[step, agent])
+    for plan in result.plans:
+        step, members, targets, blobs, labels = plan
+        recorder.objectives(step, trace[min(step, len(trace) - 1), :, :2], members, targets, blobs, labels)
+    for time, snapshot in zip(result.snapshot_times, result.snapshots, strict=True):
+        recorder.lack_map(round(time / result.scenario.dt), snapshot / 255.0)  # 8-bit snapshots
+    recorder.lack_map(result.steps, result.final_lack)
+    recorder.domain_errors(result.errors)
+    recorder.event(result.steps, "run complete" if result.completed else "run stopped at max_time")
+    recorder.close()

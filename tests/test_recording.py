@@ -1,0 +1,104 @@
+"""Recordings read back: the logger process over Zenoh and `anicov run` both write what they claim."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from anicov.engine import run_scenario
+from anicov.replay import summarise_recording
+from anicov.scenario import load_scenario
+from tests.teamrun import anicov, launcher_command, run, write_scenario
+
+EXPECTED_ENTITIES = (
+    {
+        "/world/domain",
+        "/world/map/lack_of_coverage",
+        "/world/blobs/segmentation",
+        "/world/blobs/objectives",
+        "/metrics/e_D",
+        "/run/scenario",
+        "/run/events",
+    }
+    | {f"/world/agents/{{i}}/{name}" for name in ("position", "heading", "wedge", "trail", "objective")}
+    | {f"/agents/{{i}}/{name}" for name in ("e_omega", "v", "omega")}
+)
+
+
+def expected_entities(agents: int) -> set[str]:
+    return {entity.format(i=i) for entity in EXPECTED_ENTITIES for i in range(agents)}
+
+
+def rerun_cli() -> str:
+    return str(Path(sys.executable).parent / "rerun")
+
+
+def trajectory_rows(path: Path) -> dict[tuple[int, int], tuple[float, float]]:
+    with path.open() as handle:
+        rows = csv.DictReader(handle)
+        return {(round(float(r["t"]) * 10), int(r["agent"])): (float(r["x"]), float(r["y"])) for r in rows}
+
+
+def check_recording(recording: Path, trajectory: Path, final_lack: np.ndarray, agents: int, cell: float) -> None:
+    content = summarise_recording(recording)
+    missing = expected_entities(agents) - content.entities
+    assert not missing, missing
+    assert content.agents == list(range(agents))
+    assert content.final_domain_error == 0.0
+    assert np.array_equal(content.final_map(), final_lack.astype(np.float32))
+    rows = trajectory_rows(trajectory)
+    rows_in_grid = final_lack.shape[0]
+    compared = 0
+    for agent, by_step in content.positions.items():
+        for step, (view_x, view_y) in by_step.items():
+            x, y = rows[(step, agent)]
+            assert view_x == pytest.approx(x / cell, abs=1e-4)
+            assert view_y == pytest.approx(rows_in_grid - y / cell, abs=1e-4)
+            compared += 1
+    assert compared == len(rows) - agents  # every step's pose (the final rows have no step of their own)
+
+
+def test_launch_team_recording_holds_every_entity_and_matches_the_run(tmp_path):
+    config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=2, seed=2)
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team")))
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    recording = tmp_path / "team" / "recording.rrd"
+    verified = subprocess.run([rerun_cli(), "rrd", "verify", str(recording)], capture_output=True, text=True)
+    assert verified.returncode == 0, verified.stderr
+    engine = run_scenario(load_scenario(config))
+    check_recording(recording, tmp_path / "team" / "trajectory.csv", engine.final_lack, 2, 1.0)
+    content = summarise_recording(recording, load_maps=False)
+    assert content.recording_ids == [f"{content.recording_ids[0]}"] and len(content.recording_ids) == 1
+
+
+def test_anicov_run_writes_a_recording_by_default_and_not_with_no_record(tmp_path):
+    config = write_scenario(tmp_path / "s.toml", domain=[30.0, 30.0], agents=3, seed=4)
+    done = anicov("run", "--config", str(config), "--out", str(tmp_path / "a"), "--quiet")
+    assert done.returncode == 0, done.stderr
+    engine = run_scenario(load_scenario(config))
+    check_recording(tmp_path / "a" / "recording.rrd", tmp_path / "a" / "trajectory.csv", engine.final_lack, 3, 1.0)
+    done = anicov("run", "--config", str(config), "--out", str(tmp_path / "b"), "--quiet", "--no-record")
+    assert done.returncode == 0 and not (tmp_path / "b" / "recording.rrd").exists()
+
+
+def test_replay_summary_prints_what_the_recording_holds(tmp_path):
+    config = write_scenario(tmp_path / "s.toml", domain=[30.0, 30.0], agents=2, seed=1)
+    assert anicov("run", "--config", str(config), "--out", str(tmp_path), "--quiet").returncode == 0
+    summary = anicov("replay", "--summary", str(tmp_path / "recording.rrd"))
+    assert summary.returncode == 0, summary.stderr
+    text = summary.stdout
+    assert "agents           2 (0, 1)" in text
+    assert "final e_D        0.000000" in text
+    assert "/world/map/lack_of_coverage" in text
+    steps = int(text.split("steps            0 .. ")[1].split()[0])
+    assert steps == int(__import__("json").loads((tmp_path / "summary.json").read_text())["steps"])
+
+
+def test_replay_of_a_missing_file_is_a_clear_error(tmp_path):
+    done = anicov("replay", "--summary", str(tmp_path / "none.rrd"))
+    assert done.returncode == 2 and "no recording at" in done.stderr
