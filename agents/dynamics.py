@@ -11,11 +11,17 @@ from agents.geometry import wrap_angle
 
 @njit(cache=True)
 def unicycle_step(x: float, y: float, theta: float, v: float, omega: float, dt: float) -> tuple[float, float, float]:
-    """Integrate eq. 1 exactly over dt with (v, ω) held constant (an arc, or a line if ω = 0)."""
-    if abs(omega) < 1e-9:
-        return x + v * dt * math.cos(theta), y + v * dt * math.sin(theta), theta
-    new_theta = theta + omega * dt
-    radius = v / omega
-    new_x = x + radius * (math.sin(new_theta) - math.sin(theta))
-    new_y = y - radius * (math.cos(new_theta) - math.cos(theta))
-    return new_x, new_y, wrap_angle(new_theta)
+    """Integrate eq. 1 exactly over dt with (v, ω) held constant.
+
+    The arc is written as a chord of length v·dt·sinc(ω·dt/2) along the mean
+    heading θ + ω·dt/2, which stays accurate for any ω, including ω → 0
+    (the radius form v/ω·(sin θ' − sin θ) cancels catastrophically there).
+    """
+    half_turn = 0.5 * omega * dt
+    if abs(half_turn) > 1e-4:
+        sinc = math.sin(half_turn) / half_turn
+    else:
+        sinc = 1.0 - half_turn * half_turn / 6.0
+    chord = v * dt * sinc
+    mean_heading = theta + half_turn
+    return x + chord * math.cos(mean_heading), y + chord * math.sin(mean_heading), wrap_angle(theta + omega * dt)

@@ -32,7 +32,7 @@ def test_golden_paper_run_four_agents_seed_0(paper_scenario):
     assert result.completed
     assert result.steps == 6050
     assert result.completion_time == pytest.approx(605.0)
-    assert result.path_lengths.sum() == pytest.approx(1487.0049657207753, rel=1e-12)
+    assert result.path_lengths.sum() == pytest.approx(1487.004965724296, rel=1e-12)
 
 
 def test_trace_rows_and_final_state(paper_scenario):

@@ -1,0 +1,48 @@
+"""Where numba keeps its compiled kernels: a folder keyed by the kernels' source.
+
+numba's own cache (``cache=True``) invalidates a function when *its* file
+changes, but not when a jitted function it calls, in another file, changes:
+a stale inlined copy would silently survive. Keying the cache folder by a hash
+of every file that holds a kernel makes any edit start from a clean cache.
+``NUMBA_CACHE_DIR`` set by the user wins.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+KERNEL_SOURCES = (
+    "agents/geometry.py",
+    "agents/sensing.py",
+    "agents/control.py",
+    "agents/dynamics.py",
+    "agents/step.py",
+    "protocol/fixed_point.py",
+    "protocol/coverage_map.py",
+    "anicov/engine.py",
+)
+
+
+def kernel_cache_dir() -> Path:
+    digest = hashlib.sha256()
+    for name in KERNEL_SOURCES:
+        path = ROOT / name
+        digest.update(name.encode())
+        digest.update(path.read_bytes() if path.exists() else b"")
+    return ROOT / ".numba_cache" / digest.hexdigest()[:16]
+
+
+def configure() -> None:
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return
+    folder = str(kernel_cache_dir())
+    os.environ["NUMBA_CACHE_DIR"] = folder
+    import numba
+
+    numba.config.CACHE_DIR = folder
+
+
+configure()
