@@ -231,14 +231,18 @@ def main(argv: list[str] | None = None) -> int:
                 "--recording-id",
                 f"{args.team}-{out_dir.name}",
             ]
+            logger_flags += ["--counts", str(logs / "logger.counts.json")]
             logger_flags += ["--no-record"] * args.no_record + ["--viewer"] * args.viewer + ["--serve"] * args.serve
             children.append(spawn("logger", child_command("logger", args, logger_flags), logs))
             # The logger subscribes before the agents start, so it sees the run from step 0.
             wait_for_token(router, keys.alive("logger"), timeout=60.0)
         for agent in range(scenario.agents):
-            children.append(spawn(f"agent-{agent}", child_command("agent", args, ["--id", str(agent)]), logs))
+            agent_flags = ["--id", str(agent), "--counts", str(logs / f"agent-{agent}.counts.json")]
+            children.append(spawn(f"agent-{agent}", child_command("agent", args, agent_flags), logs))
         bar = tqdm(total=100, desc=f"team of {scenario.agents}", unit="%", disable=args.quiet or None)
         coordinator = children[0]
+        reported: set[str] = set()
+        lost: list[str] = []
         try:
             while not stop.stopped:
                 status = latest.get("status")
@@ -249,13 +253,17 @@ def main(argv: list[str] | None = None) -> int:
                 if code is not None:
                     exit_code = code
                     break
-                failed = [c for c in children[1:] if c.process.poll() not in (None, 0)]
-                if failed and "done" not in latest:
-                    log.error(
-                        "%s exited with %s; see %s", failed[0].role, failed[0].process.returncode, failed[0].log_path
-                    )
-                    exit_code = EXIT_FAILED
-                    break
+                # A robot that dies is the team's problem, not the run's: the coordinator notices it
+                # through liveliness and carries on without it. Only report it.
+                for child in children[1:]:
+                    code = child.process.poll()
+                    if code is not None and child.role not in reported:
+                        reported.add(child.role)
+                        if code != 0 and "done" not in latest:
+                            log.warning(
+                                "%s exited with %s; the team carries on (see %s)", child.role, code, child.log_path
+                            )
+                            lost.append(child.role)
                 stop.event.wait(0.1)
         finally:
             bar.close()
@@ -277,6 +285,8 @@ def main(argv: list[str] | None = None) -> int:
             + ("" if args.no_record else " + logger")
             + f", logs in {logs}"
         )
+        if lost:
+            print(f"  lost on the way {', '.join(lost)} (the team completed without them)")
         if (out_dir / "recording.rrd").exists():
             print(f"  recording       {out_dir / 'recording.rrd'}   (anicov replay {out_dir / 'recording.rrd'})")
         print(f"  wall time       {time.monotonic() - started:.1f} s")

@@ -12,8 +12,9 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
-CONTROLLERS = ("paper", "paper-literal", "zigzag")
-"""``paper``: the chosen readings of eq. 11 and 16; ``paper-literal``: both as printed; ``zigzag``: Fig. 8."""
+CONTROLLERS = ("paper", "paper-literal", "paper-eq16", "zigzag")
+"""``paper``: the chosen readings of eq. 11 and 16; ``paper-literal``: both as printed; ``paper-eq16``: eq. 11
+read toward the objective but eq. 16 as printed; ``zigzag``: Fig. 8 (docs/paper-notes.md)."""
 
 
 class ScenarioError(ValueError):

@@ -50,7 +50,7 @@ def test_bad_config_fails_with_key_named(tmp_path):
     config.write_text('controller = "fast"\n')
     done = anicov("run", "--config", str(config), "--out", str(tmp_path / "o"))
     assert done.returncode == 2
-    assert "'controller': expected one of paper, paper-literal, zigzag" in done.stderr
+    assert "'controller': expected one of paper, paper-literal, paper-eq16, zigzag" in done.stderr
     assert "Traceback" not in done.stderr
 
 

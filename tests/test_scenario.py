@@ -39,7 +39,7 @@ def test_paper_file_has_exactly_the_documented_keys(paper_scenario, tmp_path):
         ("agents", 2.5, "'agents': expected an integer"),
         ("dt", -0.1, "'dt': expected a positive number"),
         ("range", "far", "'range': expected a finite number"),
-        ("controller", "magic", "'controller': expected one of paper, paper-literal, zigzag"),
+        ("controller", "magic", "'controller': expected one of paper, paper-literal, paper-eq16, zigzag"),
         ("domain", [100.0], "'domain': expected [width, height]"),
         ("half_angle_deg", 200, "'half_angle_deg': expected a number in (0, 180)"),
         ("cell", 0.3, "'cell': expected a size that divides the domain"),

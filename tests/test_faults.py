@@ -1,0 +1,260 @@
+"""Faults and bad input against a running team: real processes, real Zenoh sessions on loopback."""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import re
+import signal
+import subprocess
+import time
+from datetime import datetime
+
+import msgpack
+import numpy as np
+import pytest
+import zenoh
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from protocol.bus import zenoh_config
+from protocol.keys import TeamKeys
+from protocol.messages import (
+    AgentState,
+    Limits,
+    MapDelta,
+    Objectives,
+    ProtocolError,
+    RunControl,
+    decode,
+    encode,
+)
+from tests.teamrun import ROOT, anicov, free_port, launcher_command, processes_of, unique_team, wait_for, write_scenario
+
+
+def agents_started(logs, agents: int) -> bool:
+    return all(
+        (logs / f"agent-{i}.log").exists() and "starts" in (logs / f"agent-{i}.log").read_text() for i in range(agents)
+    )
+
+
+def pid_of(team: str, role: str) -> int:
+    found = subprocess.run(["pgrep", "-f", f"{role} --team {team} "], capture_output=True, text=True)
+    pids = [int(p) for p in found.stdout.split()]
+    assert pids, f"no {role} of team {team}"
+    return pids[0]
+
+
+def agent_pid(team: str, agent: int) -> int:
+    found = subprocess.run(["pgrep", "-af", f"team {team}"], capture_output=True, text=True)
+    for line in found.stdout.splitlines():
+        if " agent " in line and re.search(rf"--id {agent}( |$)", line):
+            return int(line.split()[0])
+    raise AssertionError(f"agent {agent} of {team} not found")
+
+
+def log_time(line: str) -> float:
+    stamp = line.split(" ")[0] + " " + line.split(" ")[1]
+    return datetime.strptime(stamp, "%Y-%m-%d %H:%M:%S,%f").timestamp()
+
+
+@pytest.mark.parametrize("clock", ["lockstep", "realtime"])
+def test_team_survives_an_agent_killed_mid_run(tmp_path, clock):
+    team = unique_team()
+    out = tmp_path / "run"
+    extra = ["--speed", "40"] if clock == "realtime" else []
+    process = subprocess.Popen(
+        launcher_command("--n", "4", "--seed", "0", "--clock", clock, *extra, "--out", str(out), team=team),
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
+        time.sleep(2.0)  # well into the run
+        killed_at = time.time()
+        os.kill(agent_pid(team, 2), signal.SIGKILL)
+        stdout, stderr = process.communicate(timeout=400)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 0, stderr + stdout
+    assert "lost on the way agent-2" in stdout
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] is True and summary["final_error"] == 0.0
+    counts = json.loads((out / "coordinator_counts.json").read_text())
+    assert "agent 2 left" in counts["events"]
+    left = [line for line in (out / "logs" / "coordinator.log").read_text().splitlines() if "agent 2 left" in line]
+    detected_after = log_time(left[0]) - killed_at
+    assert detected_after < 1.0, detected_after
+    (out / "detection_seconds.txt").write_text(f"{detected_after:.3f}\n")
+    assert wait_for(lambda: processes_of(team) == [], timeout=10)
+
+
+# ------------------------------------------------------------------ fuzzing
+
+LIMITS = Limits(rows=30, cols=30, agents=2)
+
+
+def valid_payloads() -> list[bytes]:
+    return [
+        encode(MapDelta(0, 5, 3, 4, np.ones((2, 3), dtype=np.int64))),
+        encode(AgentState(1, 7, (1.0, 2.0, 0.3), 0.5, 0.1, 0.4, (1.1, 2.0, 0.31))),
+        encode(Objectives(50, (0, 1), np.array([[1.0, 2.0], [3.0, 4.0]]), np.array([[5.0, 6.0]]))),
+        encode(RunControl("done", 10, True, 0.0)),
+    ]
+
+
+def is_malformed(payload: bytes) -> bool:
+    try:
+        decode(payload, LIMITS)
+    except ProtocolError:
+        return True
+    return False
+
+
+def mutated(rng: random.Random, payload: bytes) -> bytes:
+    data = bytearray(payload)
+    for _ in range(rng.randint(1, 4)):
+        choice = rng.random()
+        if choice < 0.5 and data:
+            data[rng.randrange(len(data))] = rng.randrange(256)
+        elif choice < 0.75 and data:
+            del data[rng.randrange(len(data))]
+        else:
+            data.insert(rng.randrange(len(data) + 1), rng.randrange(256))
+    return bytes(data)
+
+
+structured = st.recursive(
+    st.none()
+    | st.booleans()
+    | st.integers(-(2**40), 2**40)
+    | st.floats()
+    | st.text(max_size=8)
+    | st.binary(max_size=16),
+    lambda children: st.lists(children, max_size=4) | st.dictionaries(st.text(max_size=6), children, max_size=5),
+    max_leaves=12,
+)
+fields = st.fixed_dictionaries(
+    {
+        "v": st.sampled_from([1, 1, 1, 2, "1"]),
+        "type": st.sampled_from(["delta", "state", "objectives", "control", "snapshot", "x"]),
+    },
+    optional={
+        name: structured
+        for name in (
+            "agent",
+            "seq",
+            "step",
+            "row0",
+            "col0",
+            "h",
+            "w",
+            "ticks",
+            "pose",
+            "vel",
+            "next",
+            "e_omega",
+            "members",
+            "targets",
+            "blobs",
+            "kind",
+        )
+    },
+)
+
+
+def hypothesis_payloads(count: int) -> list[bytes]:
+    found: list[bytes] = []
+
+    @settings(max_examples=count, database=None, suppress_health_check=list(HealthCheck), deadline=None)
+    @given(fields)
+    def collect(body):
+        found.append(msgpack.packb(body, use_bin_type=True))
+
+    collect()
+    return found
+
+
+def malformed_payloads(total: int, seed: int = 7) -> list[bytes]:
+    """Random bytes, mutated valid messages and hypothesis-made msgpack maps; all rejected by decode."""
+    rng = random.Random(seed)
+    payloads: list[bytes] = []
+    payloads += [bytes(rng.randrange(256) for _ in range(rng.randint(0, 64))) for _ in range(total // 3)]
+    bases = valid_payloads()
+    while len(payloads) < 2 * total // 3:
+        payloads.append(mutated(rng, rng.choice(bases)))
+    payloads += hypothesis_payloads(total - len(payloads))
+    return [payload for payload in payloads if is_malformed(payload)]
+
+
+def test_fuzzed_payloads_on_every_key_are_rejected_and_the_run_is_untouched(tmp_path):
+    config = write_scenario(tmp_path / "s.toml", domain=[30.0, 30.0], agents=2, seed=9)
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+    assert engine.returncode == 0
+    payloads = malformed_payloads(4000)
+    keys = TeamKeys(unique_team())
+    targets = [
+        keys.agent_delta(0),
+        keys.agent_delta(1),
+        keys.agent_state(0),
+        keys.agent_state(1),
+        keys.objectives,
+        keys.control,
+    ]
+    port = free_port()
+    out = tmp_path / "team"
+    process = subprocess.Popen(
+        launcher_command("--config", str(config), "--out", str(out), team=keys.team, port=port),
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    sent = 0
+    try:
+        assert wait_for(lambda: agents_started(out / "logs", 2), timeout=120)
+        with zenoh.open(zenoh_config("client", connect=[f"tcp/127.0.0.1:{port}"])) as session:
+            publishers = [
+                session.declare_publisher(key, congestion_control=zenoh.CongestionControl.BLOCK) for key in targets
+            ]
+            while sent < 10_000 or (process.poll() is None and sent < 60_000):
+                for publisher in publishers:
+                    publisher.put(payloads[sent % len(payloads)])
+                    sent += 1
+                if process.poll() is not None:
+                    break
+        stdout, stderr = process.communicate(timeout=300)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert sent >= 10_000
+    assert process.returncode == 0, stderr + stdout
+    # The map, the trajectories, everything equals the run without the noise.
+    for name in ("trajectory.csv", "summary.json"):
+        assert (tmp_path / "engine" / name).read_bytes() == (out / name).read_bytes(), name
+    counts = json.loads((out / "coordinator_counts.json").read_text())
+    agent_counts = [json.loads((out / "logs" / f"agent-{i}.counts.json").read_text()) for i in range(2)]
+    logger_counts = json.loads((out / "logs" / "logger.counts.json").read_text())
+    # Every payload reached every subscriber of its key and was rejected there: none lost, none accepted.
+    per_key = sent // len(targets)
+    assert logger_counts["rejected"] == 6 * per_key  # the logger listens on all six keys
+    assert counts["rejected"] == 4 * per_key  # deltas and states
+    assert all(c["rejected"] == 4 * per_key for c in agent_counts)  # deltas, objectives, control
+    reasons = {key for c in [counts, logger_counts, *agent_counts] for key in c if key.startswith("rejected.")}
+    assert {"rejected.undecodable", "rejected.bad-version"} <= reasons
+    (out / "fuzz.json").write_text(
+        json.dumps(
+            {
+                "sent": sent,
+                "distinct": len(payloads),
+                "coordinator": counts,
+                "logger": logger_counts,
+                "agents": agent_counts,
+            },
+            indent=1,
+        )
+    )
