@@ -8,6 +8,7 @@ import random
 import re
 import signal
 import subprocess
+import sys
 import time
 from datetime import datetime
 
@@ -258,3 +259,60 @@ def test_fuzzed_payloads_on_every_key_are_rejected_and_the_run_is_untouched(tmp_
             indent=1,
         )
     )
+
+
+def test_a_late_logger_catches_up_from_the_snapshot_and_records_the_full_final_map(tmp_path):
+    from anicov.engine import run_scenario
+    from anicov.replay import summarise_recording
+    from anicov.scenario import load_scenario
+
+    config = write_scenario(tmp_path / "s.toml", domain=[60.0, 60.0], agents=3, seed=4)
+    team = unique_team()
+    port = free_port()
+    out = tmp_path / "team"
+    process = subprocess.Popen(
+        launcher_command("--config", str(config), "--out", str(out), "--no-record", team=team, port=port),
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    logger = None
+    try:
+        assert wait_for(lambda: agents_started(out / "logs", 3), timeout=120)
+        time.sleep(1.5)  # the team is well under way before the logger exists
+        recording = tmp_path / "late.rrd"
+        logger = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "anicov.cli",
+                "logger",
+                "--team",
+                team,
+                "--config",
+                str(config),
+                "--connect",
+                f"tcp/127.0.0.1:{port}",
+                "--out",
+                str(recording),
+            ],
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        stdout, stderr = process.communicate(timeout=300)
+        assert process.returncode == 0, stderr + stdout
+        _, logger_err = logger.communicate(timeout=60)
+        assert logger.returncode == 0, logger_err
+    finally:
+        for child in (process, logger):
+            if child is not None and child.poll() is None:
+                child.kill()
+    assert "loaded the coordinator's snapshot" in logger_err
+    content = summarise_recording(recording)
+    assert min(min(steps) for steps in content.positions.values()) > 0  # it really started late
+    engine = run_scenario(load_scenario(config))
+    assert np.array_equal(content.final_map(), engine.final_lack.astype(np.float32))
+    assert content.final_domain_error == 0.0
