@@ -31,7 +31,7 @@ import zenoh
 from agents.parameters import initial_poses, law_parameters
 from agents.robot import Robot, SimulatedUnicycle
 from agents.step import LawParameters, decide_and_sense
-from anicov.lifecycle import EXIT_FAILED, EXIT_OK, StopFlag, parent_is_gone
+from anicov.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone
 from anicov.scenario import Scenario
 from protocol.bus import Inbox, Membership, Received, team_publisher, write_counts
 from protocol.keys import TeamKeys
@@ -171,18 +171,28 @@ class AgentNode:
         pose = self.robot.pose()
         return AgentState(self.options.agent, -1, pose, 0.0, 0.0, 0.0, pose)
 
-    def load_snapshot(self, session: zenoh.Session) -> bool:
-        """Catch up from the coordinator's snapshot, if one is served."""
+    def resume_from_snapshot(self, session: zenoh.Session) -> bool:
+        """A restarted robot: if the coordinator's snapshot knows this agent, resume where it stopped.
+
+        The map and the applied sequences come from the snapshot (deltas arriving
+        meanwhile are applied once); the step continues after this agent's last
+        delta, and the simulated robot restarts from its last known pose (a real
+        robot reads its pose from its localisation instead).
+        """
         try:
             for reply in session.get(self.keys.snapshot, timeout=1.0):
                 if reply.ok is None:
                     continue
                 snapshot = decode(reply.ok.payload.to_bytes(), self.limits, expected="snapshot")
                 assert isinstance(snapshot, Snapshot)
-                self.replica.load(snapshot)
                 own = snapshot.applied.get(self.options.agent)
-                if own is not None:
-                    self.step = own[0] + 1
+                if own is None:
+                    return False  # a fresh run: nothing of ours to resume
+                self.replica.load(snapshot)
+                self.step = own[0] + 1
+                pose = snapshot.poses.get(self.options.agent)
+                if pose is not None and isinstance(self.robot, SimulatedUnicycle):
+                    self.robot = SimulatedUnicycle(pose, self.law)
                 return True
         except ProtocolError as error:
             log.warning("snapshot rejected: %s", error)
@@ -209,6 +219,14 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             state_publisher.put(state_bytes)
 
         lockstep = options.clock == "lockstep"
+        if node.resume_from_snapshot(session):
+            if lockstep:
+                log.error(
+                    "agent %d: a lockstep run cannot be rejoined; restart it with --clock realtime", options.agent
+                )
+                token.undeclare()
+                return EXIT_USAGE
+            log.info("agent %d resumes from the coordinator's snapshot at step %d", options.agent, node.step)
         # Wait for the first go, saying hello until the coordinator has heard it.
         next_hello = 0.0
         while node.go is None and node.finished is None and not stop.stopped:
@@ -247,8 +265,15 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
                 wait = started + (node.step - first_step) * period - time.monotonic()
                 if wait > 0:
                     stop.event.wait(wait)
+        # Let in-flight deltas of teammates land, so every replica ends with the same map.
+        drain_until = time.monotonic() + 0.5
+        while node.finished is not None and time.monotonic() < drain_until:
+            item = node.inbox.get(timeout=0.05)
+            if item is not None:
+                node.handle(item, hold_back=False)
         token.undeclare()
     counts = node.inbox.counts() | {
+        "map_digest": node.replica.digest(),
         "steps": node.step,
         "bytes_sent": node.bytes_sent,
         "duplicates": node.replica.duplicates,

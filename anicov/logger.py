@@ -93,7 +93,7 @@ class TeamLogger:
 
     def load_snapshot(self, session: zenoh.Session, keys: TeamKeys) -> None:
         """A late logger starts from the coordinator's map."""
-        for reply in session.get(keys.snapshot, timeout=2.0):
+        for reply in session.get(keys.snapshot, timeout=5.0):
             if reply.ok is None:
                 continue
             try:

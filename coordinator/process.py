@@ -13,6 +13,7 @@ from __future__ import annotations
 import logging
 import math
 import os
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -90,11 +91,28 @@ class Coordinator:
         self.bytes_sent = 0
         self.open_step: int | None = 0 if options.clock == "lockstep" else None
         self.held_back: list[MapDelta] = []
+        self.lock = threading.Lock()  # the snapshot queryable reads the replica from Zenoh's thread
+
+    def snapshot_payload(self) -> bytes:
+        """The replica with the last known poses, for a late or restarted process (Zenoh's thread)."""
+        with self.lock:
+            snapshot = self.replica.snapshot(dict(self.log.final_poses))
+        return encode(snapshot)
 
     def handle(self, item: Received | Membership) -> None:
+        with self.lock:
+            self._handle(item)
+
+    def _handle(self, item: Received | Membership) -> None:
         if isinstance(item, Membership):
             if item.alive:
                 self.alive.add(item.agent)
+                if self.members and item.agent not in self.members and self.options.clock == "realtime":
+                    # A restarted robot: it resumes from our snapshot; plan for it again.
+                    self.members.add(item.agent)
+                    self.membership_changed = True
+                    self.log.events.append(f"agent {item.agent} rejoined")
+                    log.info("agent %d rejoined the team", item.agent)
             else:
                 self.alive.discard(item.agent)
                 if item.agent in self.members:
@@ -117,6 +135,10 @@ class Coordinator:
 
     def open_next_step(self) -> None:
         """Lockstep: after the open step was closed (Λ_{k+1} measured), let step k+1's deltas in."""
+        with self.lock:
+            self._open_next_step()
+
+    def _open_next_step(self) -> None:
         assert self.open_step is not None
         self.open_step += 1
         waiting = [delta for delta in self.held_back if delta.seq > self.open_step]
@@ -187,9 +209,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         session.declare_subscriber(keys.all_deltas, node.inbox.on_sample)
         session.declare_subscriber(keys.all_states, node.inbox.on_sample)
         session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
-        session.declare_queryable(
-            keys.snapshot, lambda query: query.reply(keys.snapshot, encode(node.replica.snapshot()))
-        )
+        session.declare_queryable(keys.snapshot, lambda query: query.reply(keys.snapshot, node.snapshot_payload()))
         objectives_publisher = team_publisher(session, keys.objectives)
         control_publisher = team_publisher(session, keys.control)
         status_publisher = team_publisher(session, keys.status)
@@ -293,8 +313,16 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                 control_publisher,
                 encode(RunControl("abort", step, False, node.replica.map.domain_error(), reason="coordinator stopped")),
             )
+        # Deltas still in flight (realtime agents step until they hear the end) join the map.
+        node.open_step = None
+        drain_until = time.monotonic() + 0.5
+        while time.monotonic() < drain_until:
+            item = node.inbox.get(timeout=0.05)
+            if item is not None:
+                node.handle(item)
         token.undeclare()
         counts = node.inbox.counts() | {
+            "map_digest": node.replica.digest(),
             "bytes_sent": node.bytes_sent,
             "duplicates": node.replica.duplicates,
             "gaps": sum(len(v) for v in node.replica.gaps().values()),

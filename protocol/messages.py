@@ -100,6 +100,7 @@ class RunControl:
 class Snapshot:
     coverage: np.ndarray  # int64 (rows, cols)
     applied: dict[int, tuple[int, tuple[int, ...]]]  # agent → (contiguous seq, extra seqs)
+    poses: dict[int, Pose] = field(default_factory=dict)  # last known pose per agent (for a restarted robot)
 
 
 Message = MapDelta | AgentState | Objectives | RunControl | Snapshot
@@ -170,6 +171,7 @@ def encode(message: Message) -> bytes:
                 "cols": coverage.shape[1],
                 "map": zlib.compress(coverage.tobytes(), 1),
                 "applied": applied,
+                "poses": [[agent, *pose] for agent, pose in sorted(message.poses.items())],
             },
         )
     raise TypeError(f"not a protocol message: {type(message).__name__}")
@@ -320,5 +322,15 @@ def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Messa
             seq = _int({"s": entry[1]}, "s", -1, MAX_STEP)
             extras = tuple(_int({"e": item}, "e", seq + 1, MAX_STEP) for item in entry[2])
             applied[agent] = (seq, extras)
-        return Snapshot(coverage, applied)
+        poses: dict[int, Pose] = {}
+        poses_raw = body.get("poses", [])
+        if not isinstance(poses_raw, list):
+            raise ProtocolError("bad-field", "poses must be a list")
+        for entry in poses_raw:
+            if not (isinstance(entry, list) and len(entry) == 4):
+                raise ProtocolError("bad-shape", "pose entries are [agent, x, y, theta]")
+            agent = _int({"a": entry[0]}, "a", 0, last_agent)
+            x, y, theta = (_finite(value, "pose") for value in entry[1:])
+            poses[agent] = (x, y, theta)
+        return Snapshot(coverage, applied, poses)
     raise ProtocolError("unknown-type", repr(kind)[:40])

@@ -67,9 +67,15 @@ class MapReplica:
         """Known-missing sequences per agent (a later one arrived, these did not)."""
         return {agent: missing for agent, seqs in self.applied.items() if (missing := seqs.gaps())}
 
-    def snapshot(self) -> Snapshot:
+    def snapshot(self, poses: dict[int, tuple[float, float, float]] | None = None) -> Snapshot:
         applied = {agent: (seqs.contiguous, tuple(sorted(seqs.extras))) for agent, seqs in self.applied.items()}
-        return Snapshot(self.map.coverage.copy(), applied)
+        return Snapshot(self.map.coverage.copy(), applied, dict(poses or {}))
+
+    def digest(self) -> str:
+        """A short hash of the map, to compare replicas across processes."""
+        import hashlib
+
+        return hashlib.sha256(self.map.coverage.tobytes()).hexdigest()[:16]
 
     def load(self, snapshot: Snapshot) -> None:
         """Replace this replica's content by a snapshot (of the same grid)."""

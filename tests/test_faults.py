@@ -316,3 +316,41 @@ def test_a_late_logger_catches_up_from_the_snapshot_and_records_the_full_final_m
     engine = run_scenario(load_scenario(config))
     assert np.array_equal(content.final_map(), engine.final_lack.astype(np.float32))
     assert content.final_domain_error == 0.0
+
+
+def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_path):
+    team = unique_team()
+    port = free_port()
+    out = tmp_path / "run"
+    process = subprocess.Popen(launcher_command("--n", "4", "--seed", "0", "--clock", "realtime", "--speed", "40",
+                                                "--out", str(out), team=team, port=port),
+                               cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    restarted = None
+    try:
+        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
+        time.sleep(2.0)
+        os.kill(agent_pid(team, 1), signal.SIGKILL)
+        time.sleep(1.0)
+        restarted = subprocess.Popen(
+            [sys.executable, "-m", "anicov.cli", "agent", "--team", team, "--id", "1", "--n", "4", "--seed", "0",
+             "--clock", "realtime", "--speed", "40", "--connect", f"tcp/127.0.0.1:{port}",
+             "--counts", str(tmp_path / "restarted.json")], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+            text=True)
+        stdout, stderr = process.communicate(timeout=400)
+        _, restarted_log = restarted.communicate(timeout=60)
+    finally:
+        for child in (process, restarted):
+            if child is not None and child.poll() is None:
+                child.kill()
+    assert process.returncode == 0, stderr + stdout
+    assert restarted.returncode == 0, restarted_log
+    resumed = re.search(r"resumes from the coordinator's snapshot at step (\d+)", restarted_log)
+    assert resumed and int(resumed.group(1)) > 0
+    coordinator = json.loads((out / "coordinator_counts.json").read_text())
+    assert "agent 1 left" in coordinator["events"] and "agent 1 rejoined" in coordinator["events"]
+    restarted_counts = json.loads((tmp_path / "restarted.json").read_text())
+    assert restarted_counts["steps"] > int(resumed.group(1))  # it stepped again after resuming
+    digests = {coordinator["map_digest"], restarted_counts["map_digest"]}
+    digests |= {json.loads((out / "logs" / f"agent-{i}.counts.json").read_text())["map_digest"] for i in (0, 2, 3)}
+    assert len(digests) == 1, digests  # every replica holds the same map, bit for bit
+    assert json.loads((out / "summary.json").read_text())["completed"] is True
