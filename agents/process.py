@@ -43,6 +43,7 @@ from protocol.messages import (
     ProtocolError,
     RunControl,
     Snapshot,
+    StepGo,
     decode,
     encode,
 )
@@ -79,77 +80,62 @@ class AgentNode:
         self.inbox = Inbox(self.limits, options.drop_rate, seed=1000 + options.agent)
         self.step = 0
         self.objective: tuple[float, float] | None = None
-        self.go: Objectives | None = None
-        self.next_go: Objectives | None = None
-        self.held_back: list[MapDelta] = []
+        self.started = False  # the coordinator has sent the first go or objectives
+        self.gos: dict[int, StepGo] = {}  # lockstep: gos received for steps not yet taken
         self.finished: RunControl | None = None
         self.bytes_sent = 0
 
     # ------------------------------------------------------------ messages
 
-    def handle(self, item: Received | Membership, hold_back: bool) -> None:
+    def handle(self, item: Received | Membership) -> None:
         if isinstance(item, Membership):
             return
         message = item.message
-        if isinstance(message, MapDelta):
-            if message.agent == self.options.agent:
-                return  # our own echo: applied when it was made
-            if hold_back and message.seq >= self.step:
-                self.held_back.append(message)
-            else:
+        if isinstance(message, MapDelta):  # realtime: teammates' deltas, applied as they come
+            if message.agent != self.options.agent:
                 self.replica.apply(message)
+        elif isinstance(message, StepGo):
+            if message.step >= self.step:
+                self.gos[message.step] = message
+            self.started = True
         elif isinstance(message, Objectives):
-            if hold_back and message.step > self.step:
-                self.next_go = message  # a go for a step this agent has not reached yet
-            else:
-                self.accept(message)
+            self.take_targets(message)
+            self.started = True
         elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
             self.finished = message
 
-    def accept(self, objectives: Objectives) -> None:
-        """Take a go (or, from an earlier step, a membership update) with this agent's target."""
-        self.go = objectives
+    def apply_remaining_gos(self) -> None:
+        """At the end of a run: the last go completes the map even if the end arrived first."""
+        for step in sorted(self.gos):
+            for delta in self.gos.pop(step).deltas:
+                if delta.agent != self.options.agent:
+                    self.replica.apply(delta)
+
+    def take_targets(self, objectives: Objectives) -> None:
         target = objectives.target_of(self.options.agent)
         if target is not None:
             self.objective = target
 
-    def release_held_back(self) -> None:
-        """Deltas of steps before the next one may now enter the replica."""
-        keep = []
-        for delta in self.held_back:
-            if delta.seq < self.step:
-                self.replica.apply(delta)
-            else:
-                keep.append(delta)
-        self.held_back = keep
-
     def ready_for_step(self) -> bool:
-        """Lockstep: every member's previous delta is here, and on a replanning step so is its go.
-
-        Never ready once the replica is fully covered or max_time is reached:
-        the agent then waits for the coordinator's end of run.
-        """
+        """Lockstep: the go for this step is here. Its deltas (every member's previous step) enter
+        the replica, which then holds exactly Λ_k, and its objectives, if any, are taken."""
+        go = self.gos.pop(self.step, None)
+        if go is None:
+            return False
+        for delta in go.deltas:
+            if delta.agent != self.options.agent:
+                self.replica.apply(delta)
+        if go.objectives is not None:
+            self.take_targets(go.objectives)
         if self.replica.map.complete or self.step >= self.scenario.max_steps:
-            return False
-        if self.next_go is not None and self.next_go.step <= self.step:
-            self.accept(self.next_go)
-            self.next_go = None
-        if self.go is None or self.objective is None:
-            return False
-        if self.step % self.scenario.replan_steps == 0 and self.go.step != self.step:
-            return False
-        return all(
-            self.replica.has(member, self.step - 1) for member in self.go.members if member != self.options.agent
-        )
+            return False  # the last go only completes the map: wait for the end of the run
+        if self.objective is None:
+            raise RuntimeError(f"agent {self.options.agent} has no objective at step {self.step}")
+        return True
 
     def waiting_for(self) -> str:
         """What a lockstep step is waiting on, for the log."""
-        if self.go is None:
-            return "the coordinator's first go"
-        if self.step % self.scenario.replan_steps == 0 and self.go.step != self.step:
-            return f"the coordinator's go for step {self.step}"
-        missing = [m for m in self.go.members if m != self.options.agent and not self.replica.has(m, self.step - 1)]
-        return f"deltas of step {self.step - 1} from agents {missing}"
+        return f"the coordinator's go for step {self.step}"
 
     # ------------------------------------------------------------ control
 
@@ -204,9 +190,14 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
     parent = os.getppid()
     keys = node.keys
     with zenoh.open(config) as session:
-        # Remote only: our own deltas are applied when made, an echo would only cost a decode.
-        session.declare_subscriber(keys.all_deltas, node.inbox.on_sample, allowed_origin=zenoh.Locality.REMOTE)
-        session.declare_subscriber(keys.objectives, node.inbox.on_sample)
+        lockstep = options.clock == "lockstep"
+        if lockstep:
+            # Teammates' deltas arrive bundled in the coordinator's go: one message a step, not N − 1.
+            session.declare_subscriber(keys.go, node.inbox.on_sample)
+        else:
+            # Remote only: our own deltas are applied when made, an echo would only cost a decode.
+            session.declare_subscriber(keys.all_deltas, node.inbox.on_sample, allowed_origin=zenoh.Locality.REMOTE)
+            session.declare_subscriber(keys.objectives, node.inbox.on_sample)
         session.declare_subscriber(keys.control, node.inbox.on_sample)
         delta_publisher = team_publisher(session, keys.agent_delta(options.agent))
         state_publisher = team_publisher(session, keys.agent_state(options.agent))
@@ -218,7 +209,6 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             delta_publisher.put(delta_bytes)
             state_publisher.put(state_bytes)
 
-        lockstep = options.clock == "lockstep"
         if node.resume_from_snapshot(session):
             if lockstep:
                 log.error(
@@ -229,13 +219,13 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             log.info("agent %d resumes from the coordinator's snapshot at step %d", options.agent, node.step)
         # Wait for the first go, saying hello until the coordinator has heard it.
         next_hello = 0.0
-        while node.go is None and node.finished is None and not stop.stopped:
+        while not node.started and node.finished is None and not stop.stopped:
             if time.monotonic() >= next_hello:
                 state_publisher.put(encode(node.hello()))
                 next_hello = time.monotonic() + HELLO_PERIOD
             item = node.inbox.get(timeout=0.05)
             if item is not None:
-                node.handle(item, hold_back=lockstep)
+                node.handle(item)
             if parent_is_gone(parent):
                 break
         log.info("agent %d starts (%s clock)", options.agent, options.clock)
@@ -248,29 +238,29 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
                 while not node.ready_for_step() and node.finished is None and not stop.stopped:
                     item = node.inbox.get(timeout=0.5)
                     if item is not None:
-                        node.handle(item, hold_back=True)
+                        node.handle(item)
                     if time.monotonic() - waiting_since > 5.0:
                         log.info("agent %d still waiting at step %d: %s", options.agent, node.step, node.waiting_for())
                         waiting_since = time.monotonic()
                 if node.finished is not None or stop.stopped:
                     break
                 publish(*node.control_step())
-                node.release_held_back()
             else:
                 while (item := node.inbox.get(timeout=0)) is not None:
-                    node.handle(item, hold_back=False)
+                    node.handle(item)
                 if node.finished is not None:
                     break
                 publish(*node.control_step())
                 wait = started + (node.step - first_step) * period - time.monotonic()
                 if wait > 0:
-                    stop.event.wait(wait)
+                    stop.wait(wait)
         # Let in-flight deltas of teammates land, so every replica ends with the same map.
         drain_until = time.monotonic() + 0.5
         while node.finished is not None and time.monotonic() < drain_until:
             item = node.inbox.get(timeout=0.05)
             if item is not None:
-                node.handle(item, hold_back=False)
+                node.handle(item)
+        node.apply_remaining_gos()
         token.undeclare()
     counts = node.inbox.counts() | {
         "map_digest": node.replica.digest(),

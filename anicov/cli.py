@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
 import subprocess
 import sys
@@ -84,6 +85,9 @@ def command_logger(args: argparse.Namespace) -> int:
     from protocol.bus import zenoh_config
 
     setup_logging("logger", args.verbose)
+    if args.nice:
+        # The logger is off the team's critical path: let the robots' processes have the CPU first.
+        os.nice(args.nice)
     stop = StopFlag().install()
     scenario = _process_scenario(args)
     options = LoggerOptions(
@@ -94,6 +98,7 @@ def command_logger(args: argparse.Namespace) -> int:
         args.serve,
         args.map_every,
         args.counts,
+        args.clock,
     )
     config = zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
     return run_logger(scenario, options, config, stop)
@@ -153,7 +158,8 @@ def command_router(args: argparse.Namespace) -> int:
     config = zenoh_config("router", listen=args.listen, config_file=args.zenoh_config)
     with zenoh.open(config):
         print(f"anicov router listening on {', '.join(args.listen or ['(config file)'])}; Ctrl-C stops it", flush=True)
-        stop.event.wait()
+        while not stop.wait(3600.0):
+            pass
     return stop.exit_code(EXIT_OK)
 
 
@@ -207,6 +213,9 @@ def build_parser() -> argparse.ArgumentParser:
     logger.add_argument("--serve", action="store_true", help="serve a web viewer for a remote browser")
     logger.add_argument("--map-every", type=int, default=50, help="log the map every K steps (default 50)")
     logger.add_argument("--counts", help="write message counters to this JSON file at exit")
+    logger.add_argument(
+        "--nice", type=int, default=0, help="lower this process's CPU priority by this much (default 0)"
+    )
     _add_process_arguments(logger)
     logger.set_defaults(handler=command_logger)
 

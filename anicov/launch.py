@@ -264,7 +264,7 @@ def main(argv: list[str] | None = None) -> int:
                                 "%s exited with %s; the team carries on (see %s)", child.role, code, child.log_path
                             )
                             lost.append(child.role)
-                stop.event.wait(0.1)
+                stop.wait(0.1)
         finally:
             bar.close()
             if not stop.stopped:

@@ -7,7 +7,7 @@ import logging
 import os
 import signal
 import sys
-import threading
+import time
 from types import FrameType
 
 log = logging.getLogger("anicov")
@@ -21,10 +21,18 @@ EXIT_SIGTERM = 143
 
 
 class StopFlag:
-    """Set by SIGINT or SIGTERM; main loops poll it and leave through their ``with`` blocks."""
+    """Set by SIGINT or SIGTERM; main loops poll it and leave through their ``with`` blocks.
+
+    The handler only assigns attributes: it runs between two bytecodes of the
+    main thread, which may be holding a lock at that moment (inside
+    ``Event.set`` or a ``Condition``), so taking any lock here could deadlock
+    the process for good. Waiting is done by polling in short sleeps.
+    """
+
+    POLL_SECONDS = 0.02
 
     def __init__(self) -> None:
-        self.event = threading.Event()
+        self._stopped = False
         self.signal_number: int | None = None
 
     def install(self) -> StopFlag:
@@ -33,12 +41,26 @@ class StopFlag:
         return self
 
     def _on_signal(self, number: int, _frame: FrameType | None) -> None:
-        self.signal_number = number
-        self.event.set()
+        if self.signal_number is None:
+            self.signal_number = number
+        self._stopped = True
+
+    def set(self) -> None:
+        self._stopped = True
 
     @property
     def stopped(self) -> bool:
-        return self.event.is_set()
+        return self._stopped
+
+    def wait(self, seconds: float) -> bool:
+        """Sleep up to ``seconds``, returning early (True) once stopped."""
+        deadline = time.monotonic() + seconds
+        while not self._stopped:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                return False
+            time.sleep(min(remaining, self.POLL_SECONDS))
+        return True
 
     def exit_code(self, otherwise: int) -> int:
         if self.signal_number == signal.SIGINT:

@@ -22,7 +22,17 @@ from anicov.recording import RunRecorder
 from anicov.scenario import Scenario
 from protocol.bus import Inbox, Membership, Received, write_counts
 from protocol.keys import TeamKeys
-from protocol.messages import AgentState, Limits, MapDelta, Objectives, ProtocolError, RunControl, Snapshot, decode
+from protocol.messages import (
+    AgentState,
+    Limits,
+    MapDelta,
+    Objectives,
+    ProtocolError,
+    RunControl,
+    Snapshot,
+    StepGo,
+    decode,
+)
 from protocol.replica import MapReplica
 
 log = logging.getLogger("anicov.logger")
@@ -40,6 +50,7 @@ class LoggerOptions:
     serve_web: bool = False
     map_every: int = 50
     counts_file: str | None = None
+    clock: str = "lockstep"
 
 
 class TeamLogger:
@@ -48,7 +59,7 @@ class TeamLogger:
         rows, cols = scenario.grid_shape
         self.limits = Limits(rows, cols, scenario.agents)
         self.replica = MapReplica(rows, cols, scenario.cell, scenario.lambda_star)
-        self.inbox = Inbox(self.limits)
+        self.inbox = Inbox(self.limits, defer_decoding=True)
         self.recorder = RunRecorder(
             scenario,
             options.recording_id,
@@ -84,6 +95,19 @@ class TeamLogger:
                 self.recorder.domain_error(self.latest_step, self.replica.map.domain_error())
                 if self.latest_step % self.recorder.map_every == 0:
                     self.recorder.lack_map(self.latest_step, self.replica.map.lack_of_coverage())
+        elif isinstance(message, StepGo):
+            for delta in message.deltas:
+                self.replica.apply(delta)
+            if message.objectives is not None:
+                objectives = message.objectives
+                self.recorder.objectives(
+                    objectives.step,
+                    self.positions,
+                    objectives.members,
+                    objectives.targets,
+                    objectives.blobs,
+                    objectives.labels,
+                )
         elif isinstance(message, Objectives):
             self.recorder.objectives(
                 message.step, self.positions, message.members, message.targets, message.blobs, message.labels
@@ -123,7 +147,9 @@ def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config,
     keys = TeamKeys(options.team)
     parent = os.getppid()
     with zenoh.open(config) as session:
-        for key in (keys.all_deltas, keys.all_states, keys.objectives, keys.control):
+        # Lockstep bundles every step's deltas (and the objectives) in the coordinator's go.
+        traffic = (keys.go,) if options.clock == "lockstep" else (keys.all_deltas, keys.objectives)
+        for key in (*traffic, keys.all_states, keys.control):
             session.declare_subscriber(key, node.inbox.on_sample)
         session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
         token = session.liveliness().declare_token(keys.alive("logger"))

@@ -93,6 +93,7 @@ class RunRecorder:
             deque(maxlen=TRAIL_STEPS // self.map_every + 1) for _ in range(scenario.agents)
         ]
         self._pending: dict[int, list[tuple[int, float, float, float, float, float, float]]] = {}
+        self._pending_errors: list[tuple[int, float]] = []
         self._log_static()
 
     # -------------------------------------------------------------- helpers
@@ -171,13 +172,18 @@ class RunRecorder:
                     f"agents/{agent}/{name}", indexes=indexes, columns=rr.Scalars.columns(scalars=data[:, column])
                 )
         self._pending = {}
+        if self._pending_errors:
+            data = np.array(self._pending_errors)
+            self.domain_errors(data[:, 1], data[:, 0].astype(np.int64))
+            self._pending_errors = []
 
     def domain_error(self, step: int, value: float) -> None:
-        self._at(step)
-        self.stream.log("metrics/e_D", rr.Scalars(value))
+        """e_D after ``step`` steps; buffered, sent with the states."""
+        self._pending_errors.append((step, value))
 
-    def domain_errors(self, errors: np.ndarray) -> None:
-        steps = np.arange(len(errors), dtype=np.int64)
+    def domain_errors(self, errors: np.ndarray, steps: np.ndarray | None = None) -> None:
+        """A series of e_D, one per step (from step 0 unless ``steps`` are given)."""
+        steps = np.arange(len(errors), dtype=np.int64) if steps is None else steps
         self.stream.send_columns(
             "metrics/e_D",
             indexes=[

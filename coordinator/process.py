@@ -26,7 +26,7 @@ from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, pa
 from anicov.scenario import Scenario
 from protocol.bus import Inbox, Membership, Received, team_publisher, write_counts
 from protocol.keys import TeamKeys
-from protocol.messages import AgentState, Limits, MapDelta, Objectives, RunControl, encode
+from protocol.messages import AgentState, Limits, MapDelta, Objectives, RunControl, StepGo, encode
 from protocol.replica import MapReplica
 
 log = logging.getLogger("anicov.coordinator")
@@ -91,6 +91,7 @@ class Coordinator:
         self.bytes_sent = 0
         self.open_step: int | None = 0 if options.clock == "lockstep" else None
         self.held_back: list[MapDelta] = []
+        self.open_deltas: dict[int, MapDelta] = {}
         self.lock = threading.Lock()  # the snapshot queryable reads the replica from Zenoh's thread
 
     def snapshot_payload(self) -> bytes:
@@ -126,26 +127,47 @@ class Coordinator:
             if self.open_step is not None and message.seq > self.open_step:
                 self.held_back.append(message)  # lockstep: Λ must not run ahead of the step being closed
             else:
-                self.replica.apply(message)
+                self.offer(message)
         elif isinstance(message, AgentState):
             self.log.record(message)
             if message.step >= self.latest_state_step.get(message.agent, -2):
                 self.latest_state_step[message.agent] = message.step
                 self.positions[message.agent] = (message.next_pose[0], message.next_pose[1])
 
-    def open_next_step(self) -> None:
-        """Lockstep: after the open step was closed (Λ_{k+1} measured), let step k+1's deltas in."""
-        with self.lock:
-            self._open_next_step()
+    def open_next_step(self) -> list[MapDelta]:
+        """Lockstep: after the open step was closed (Λ_{k+1} measured), let step k+1's deltas in.
 
-    def _open_next_step(self) -> None:
+        Returns the closed step's deltas, for the go that announces the next step."""
+        with self.lock:
+            return self._open_next_step()
+
+    def _open_next_step(self) -> list[MapDelta]:
         assert self.open_step is not None
+        closed = list(self.open_deltas.values())
+        self.open_deltas = {}
         self.open_step += 1
         waiting = [delta for delta in self.held_back if delta.seq > self.open_step]
         for delta in self.held_back:
             if delta.seq <= self.open_step:
-                self.replica.apply(delta)
+                self.offer(delta)
         self.held_back = waiting
+        return closed
+
+    def offer(self, delta: MapDelta) -> None:
+        """Apply a delta; in lockstep keep the open step's for the next go."""
+        if self.replica.apply(delta) and delta.seq == self.open_step:
+            self.open_deltas[delta.agent] = delta
+
+    def plan_if_due(self, step: int) -> Objectives | None:
+        """Objectives for a go: on a replanning step or after a change of members, else None."""
+        if step % self.scenario.replan_steps == 0 or self.membership_changed:
+            return self.plan(step)
+        return None
+
+    def go(self, step: int, deltas: list[MapDelta]) -> StepGo:
+        """Lockstep: step ``step`` may start, with every member's previous delta."""
+        kept = tuple(delta for delta in deltas if delta.agent in self.members)
+        return StepGo(step, tuple(sorted(self.members)), kept, self.plan_if_due(step) if self.members else None)
 
     def plan(self, step: int) -> Objectives:
         members = sorted(self.members)
@@ -211,6 +233,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
         session.declare_queryable(keys.snapshot, lambda query: query.reply(keys.snapshot, node.snapshot_payload()))
         objectives_publisher = team_publisher(session, keys.objectives)
+        go_publisher = team_publisher(session, keys.go)
         control_publisher = team_publisher(session, keys.control)
         status_publisher = team_publisher(session, keys.status)
         token = session.liveliness().declare_token(keys.alive("coordinator"))
@@ -226,7 +249,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             if item is not None:
                 node.handle(item)
             if parent_is_gone(parent):
-                stop.event.set()
+                stop.set()
         if len(node.positions) < scenario.agents:
             log.error("only %d of %d agents said hello; giving up", len(node.positions), scenario.agents)
             publish(control_publisher, encode(RunControl("abort", 0, reason="agents missing at start")))
@@ -240,14 +263,17 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         step = 0
         started = time.monotonic()
         next_plan = started
-        publish(objectives_publisher, encode(node.plan(0)))
+        if lockstep:
+            publish(go_publisher, encode(node.go(0, [])))
+        else:
+            publish(objectives_publisher, encode(node.plan(0)))
         while outcome is None and not stop.stopped:
             if parent_is_gone(parent):
-                stop.event.set()
+                stop.set()
                 break
             if lockstep:
-                # Close steps in order as their deltas and states come in; the agents pace
-                # each other between replanning steps, the go is needed on those only.
+                # Close steps in order as their deltas and states come in; each closed step k−1
+                # becomes the go for step k, carrying every member's delta of step k−1.
                 item = node.inbox.get(timeout=0.5)
                 if item is not None:
                     node.handle(item)
@@ -259,15 +285,11 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                         node.take_snapshot(step * scenario.dt)
                     if node.replica.map.complete or step >= scenario.max_steps or not node.members:
                         outcome = (step, node.replica.map.complete, step)
+                        # The last go only completes every replica; the agents then wait for the end.
+                        last = tuple(node.open_next_step())
+                        publish(go_publisher, encode(StepGo(step, tuple(sorted(node.members)), last)))
                         break
-                    node.open_next_step()
-                    if step % scenario.replan_steps == 0:
-                        publish(objectives_publisher, encode(node.plan(step)))
-                if outcome is not None:
-                    break
-                if node.membership_changed and node.members:
-                    # Someone left mid-block: tell the rest whom to wait for, with new targets.
-                    publish(objectives_publisher, encode(node.plan(step)))
+                    publish(go_publisher, encode(node.go(step, node.open_next_step())))
             else:
                 item = node.inbox.get(timeout=0.01)
                 while item is not None:

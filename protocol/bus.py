@@ -81,6 +81,12 @@ class Received:
 
 
 @dataclass(frozen=True)
+class _Raw:
+    key: str
+    payload: bytes
+
+
+@dataclass(frozen=True)
 class Membership:
     agent: int
     alive: bool
@@ -89,8 +95,11 @@ class Membership:
 class Inbox:
     """Validated messages (and liveliness changes) for the main thread, with rejection counts."""
 
-    def __init__(self, limits: Limits, drop_rate: float = 0.0, seed: int = 0) -> None:
+    def __init__(self, limits: Limits, drop_rate: float = 0.0, seed: int = 0, defer_decoding: bool = False) -> None:
+        """``defer_decoding``: decode on the main thread instead of Zenoh's. A process off the critical
+        path (the logger) then never slows Zenoh's delivery thread, and through it the publishers."""
         self.limits = limits
+        self.defer_decoding = defer_decoding
         self.queue: queue.SimpleQueue[Received | Membership] = queue.SimpleQueue()
         self.rejected: Counter[str] = Counter()
         self.accepted = 0
@@ -113,6 +122,14 @@ class Inbox:
             if self._drop_rate and self._drop_random.random() < self._drop_rate:
                 self.dropped += 1
                 return
+        if self.defer_decoding:
+            self.queue.put(_Raw(key, payload))
+            return
+        received = self._validate(key, payload)
+        if received is not None:
+            self.queue.put(received)
+
+    def _validate(self, key: str, payload: bytes) -> Received | None:
         try:
             message = decode(payload, self.limits)
             sender = agent_of_key(key)
@@ -121,10 +138,10 @@ class Inbox:
                 raise ProtocolError("wrong-sender", f"agent {agent} published on {key}")
         except ProtocolError as error:
             self._reject(error.reason, key, str(error))
-            return
+            return None
         with self._lock:
             self.accepted += 1
-        self.queue.put(Received(key, message))
+        return Received(key, message)
 
     def on_liveliness(self, sample: zenoh.Sample) -> None:
         agent = agent_of_key(str(sample.key_expr))
@@ -140,10 +157,20 @@ class Inbox:
             log.warning("rejected payload on %s: %s (%d so far)", key, detail or reason, count)
 
     def get(self, timeout: float | None) -> Received | Membership | None:
-        try:
-            return self.queue.get(timeout=timeout) if timeout is None or timeout > 0 else self.queue.get_nowait()
-        except queue.Empty:
-            return None
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while True:
+            remaining = None if deadline is None else deadline - time.monotonic()
+            try:
+                item = (
+                    self.queue.get(timeout=remaining) if remaining is None or remaining > 0 else self.queue.get_nowait()
+                )
+            except queue.Empty:
+                return None
+            if not isinstance(item, _Raw):
+                return item
+            received = self._validate(item.key, item.payload)
+            if received is not None:
+                return received
 
     def counts(self) -> dict[str, int]:
         with self._lock:

@@ -55,6 +55,10 @@ class TeamKeys:
         return f"{self.prefix}/coordinator/objectives"
 
     @property
+    def go(self) -> str:
+        return f"{self.prefix}/coordinator/go"
+
+    @property
     def snapshot(self) -> str:
         return f"{self.prefix}/coordinator/snapshot"
 

@@ -103,7 +103,17 @@ class Snapshot:
     poses: dict[int, Pose] = field(default_factory=dict)  # last known pose per agent (for a restarted robot)
 
 
-Message = MapDelta | AgentState | Objectives | RunControl | Snapshot
+@dataclass(frozen=True)
+class StepGo:
+    """Lockstep: step k may start. Carries every member's step k−1 delta, and on a replan the objectives."""
+
+    step: int
+    members: tuple[int, ...]
+    deltas: tuple[MapDelta, ...]
+    objectives: Objectives | None = None
+
+
+Message = MapDelta | AgentState | Objectives | RunControl | Snapshot | StepGo
 
 
 # ---------------------------------------------------------------- encoding
@@ -113,19 +123,42 @@ def _pack(kind: str, body: dict[str, Any]) -> bytes:
     return msgpack.packb({"v": PROTOCOL_VERSION, "type": kind, **body}, use_bin_type=True)
 
 
+def _delta_body(message: MapDelta) -> dict[str, Any]:
+    ticks = np.ascontiguousarray(message.ticks, dtype="<i8")
+    return {
+        "agent": message.agent,
+        "seq": message.seq,
+        "row0": message.row0,
+        "col0": message.col0,
+        "h": ticks.shape[0],
+        "w": ticks.shape[1],
+        "ticks": ticks.tobytes(),
+    }
+
+
+def _objectives_body(message: Objectives) -> dict[str, Any]:
+    body: dict[str, Any] = {
+        "step": message.step,
+        "members": list(message.members),
+        "targets": np.asarray(message.targets, float).ravel().tolist(),
+        "blobs": np.asarray(message.blobs, float).ravel().tolist(),
+    }
+    if message.labels is not None:
+        body["labels"] = zlib.compress(np.ascontiguousarray(message.labels, dtype="<u2").tobytes(), 1)
+    return body
+
+
 def encode(message: Message) -> bytes:
     if isinstance(message, MapDelta):
-        ticks = np.ascontiguousarray(message.ticks, dtype="<i8")
+        return _pack("delta", _delta_body(message))
+    if isinstance(message, StepGo):
         return _pack(
-            "delta",
+            "go",
             {
-                "agent": message.agent,
-                "seq": message.seq,
-                "row0": message.row0,
-                "col0": message.col0,
-                "h": ticks.shape[0],
-                "w": ticks.shape[1],
-                "ticks": ticks.tobytes(),
+                "step": message.step,
+                "members": list(message.members),
+                "deltas": [_delta_body(delta) for delta in message.deltas],
+                "objectives": None if message.objectives is None else _objectives_body(message.objectives),
             },
         )
     if isinstance(message, AgentState):
@@ -141,15 +174,7 @@ def encode(message: Message) -> bytes:
             },
         )
     if isinstance(message, Objectives):
-        body = {
-            "step": message.step,
-            "members": list(message.members),
-            "targets": np.asarray(message.targets, float).ravel().tolist(),
-            "blobs": np.asarray(message.blobs, float).ravel().tolist(),
-        }
-        if message.labels is not None:
-            body["labels"] = zlib.compress(np.ascontiguousarray(message.labels, dtype="<u2").tobytes(), 1)
-        return _pack("objectives", body)
+        return _pack("objectives", _objectives_body(message))
     if isinstance(message, RunControl):
         return _pack(
             "control",
@@ -234,6 +259,46 @@ def _inflate(packed: Any, size: int, name: str) -> bytes:
     return raw
 
 
+def _decode_delta(body: dict[str, Any], limits: Limits) -> MapDelta:
+    last_agent = limits.agents - 1
+    agent = _int(body, "agent", 0, last_agent)
+    seq = _int(body, "seq", 0, MAX_STEP)
+    height = _int(body, "h", 0, limits.rows)
+    width = _int(body, "w", 0, limits.cols)
+    row0 = _int(body, "row0", 0, limits.rows)
+    col0 = _int(body, "col0", 0, limits.cols)
+    if row0 + height > limits.rows or col0 + width > limits.cols:
+        raise ProtocolError("window-outside-grid", f"{height}x{width} at ({row0}, {col0})")
+    raw = body.get("ticks")
+    if not isinstance(raw, bytes) or len(raw) != 8 * height * width:
+        raise ProtocolError("bad-shape", "ticks must hold h*w int64")
+    ticks = np.frombuffer(raw, dtype="<i8").reshape(height, width).astype(np.int64)
+    if (ticks < 0).any():
+        raise ProtocolError("negative-delta")
+    return MapDelta(agent, seq, row0, col0, ticks)
+
+
+def _decode_objectives(body: dict[str, Any], limits: Limits) -> Objectives:
+    last_agent = limits.agents - 1
+    step = _int(body, "step", 0, MAX_STEP)
+    members = body.get("members")
+    if not isinstance(members, list) or any(isinstance(m, bool) or not isinstance(m, int) for m in members):
+        raise ProtocolError("bad-field", "members must be a list of integers")
+    if any(not 0 <= m <= last_agent for m in members) or len(set(members)) != len(members):
+        raise ProtocolError("out-of-range", "members must be distinct agent ids")
+    targets = _floats(body, "targets", 2 * len(members))
+    blobs = _floats(body, "blobs")
+    if len(blobs) % 2:
+        raise ProtocolError("bad-shape", "blobs must hold (x, y) pairs")
+    labels = None
+    if body.get("labels") is not None:
+        raw = _inflate(body["labels"], 2 * limits.rows * limits.cols, "labels")
+        labels = np.frombuffer(raw, dtype="<u2").reshape(limits.rows, limits.cols).astype(np.uint16)
+        if labels.max(initial=0) > len(blobs) // 2:
+            raise ProtocolError("out-of-range", "labels name a blob that does not exist")
+    return Objectives(step, tuple(members), np.array(targets).reshape(-1, 2), np.array(blobs).reshape(-1, 2), labels)
+
+
 def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Message:
     """Decode and validate one payload; raise ProtocolError (with ``.reason``) if it is not acceptable."""
     body = _header(payload)
@@ -242,21 +307,7 @@ def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Messa
         raise ProtocolError("wrong-type", f"expected {expected}, got {kind!r}")
     last_agent = limits.agents - 1
     if kind == "delta":
-        agent = _int(body, "agent", 0, last_agent)
-        seq = _int(body, "seq", 0, MAX_STEP)
-        height = _int(body, "h", 0, limits.rows)
-        width = _int(body, "w", 0, limits.cols)
-        row0 = _int(body, "row0", 0, limits.rows)
-        col0 = _int(body, "col0", 0, limits.cols)
-        if row0 + height > limits.rows or col0 + width > limits.cols:
-            raise ProtocolError("window-outside-grid", f"{height}x{width} at ({row0}, {col0})")
-        raw = body.get("ticks")
-        if not isinstance(raw, bytes) or len(raw) != 8 * height * width:
-            raise ProtocolError("bad-shape", "ticks must hold h*w int64")
-        ticks = np.frombuffer(raw, dtype="<i8").reshape(height, width).astype(np.int64)
-        if (ticks < 0).any():
-            raise ProtocolError("negative-delta")
-        return MapDelta(agent, seq, row0, col0, ticks)
+        return _decode_delta(body, limits)
     if kind == "state":
         pose = _floats(body, "pose", 3)
         vel = _floats(body, "vel", 2)
@@ -274,25 +325,32 @@ def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Messa
             (nxt[0], nxt[1], nxt[2]),
         )
     if kind == "objectives":
+        return _decode_objectives(body, limits)
+    if kind == "go":
         step = _int(body, "step", 0, MAX_STEP)
         members = body.get("members")
         if not isinstance(members, list) or any(isinstance(m, bool) or not isinstance(m, int) for m in members):
             raise ProtocolError("bad-field", "members must be a list of integers")
         if any(not 0 <= m <= last_agent for m in members) or len(set(members)) != len(members):
             raise ProtocolError("out-of-range", "members must be distinct agent ids")
-        targets = _floats(body, "targets", 2 * len(members))
-        blobs = _floats(body, "blobs")
-        if len(blobs) % 2:
-            raise ProtocolError("bad-shape", "blobs must hold (x, y) pairs")
-        labels = None
-        if body.get("labels") is not None:
-            raw = _inflate(body["labels"], 2 * limits.rows * limits.cols, "labels")
-            labels = np.frombuffer(raw, dtype="<u2").reshape(limits.rows, limits.cols).astype(np.uint16)
-            if labels.max(initial=0) > len(blobs) // 2:
-                raise ProtocolError("out-of-range", "labels name a blob that does not exist")
-        return Objectives(
-            step, tuple(members), np.array(targets).reshape(-1, 2), np.array(blobs).reshape(-1, 2), labels
-        )
+        raw_deltas = body.get("deltas")
+        if not isinstance(raw_deltas, list) or len(raw_deltas) > limits.agents:
+            raise ProtocolError("bad-field", "deltas must be a list, at most one per agent")
+        deltas = []
+        for item in raw_deltas:
+            if not isinstance(item, dict):
+                raise ProtocolError("bad-field", "each delta must be a map")
+            delta = _decode_delta(item, limits)
+            if delta.seq != step - 1:
+                raise ProtocolError("out-of-range", "a go for step k carries deltas of step k-1 only")
+            deltas.append(delta)
+        if len({delta.agent for delta in deltas}) != len(deltas):
+            raise ProtocolError("out-of-range", "one delta per agent")
+        raw_objectives = body.get("objectives")
+        if raw_objectives is not None and not isinstance(raw_objectives, dict):
+            raise ProtocolError("bad-field", "objectives must be a map or nil")
+        objectives = None if raw_objectives is None else _decode_objectives(raw_objectives, limits)
+        return StepGo(step, tuple(members), tuple(deltas), objectives)
     if kind == "control":
         control_kind = body.get("kind")
         if control_kind not in RUN_CONTROL_KINDS:

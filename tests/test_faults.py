@@ -204,6 +204,7 @@ def test_fuzzed_payloads_on_every_key_are_rejected_and_the_run_is_untouched(tmp_
         keys.agent_state(0),
         keys.agent_state(1),
         keys.objectives,
+        keys.go,
         keys.control,
     ]
     port = free_port()
@@ -222,7 +223,7 @@ def test_fuzzed_payloads_on_every_key_are_rejected_and_the_run_is_untouched(tmp_
             publishers = [
                 session.declare_publisher(key, congestion_control=zenoh.CongestionControl.BLOCK) for key in targets
             ]
-            while sent < 10_000 or (process.poll() is None and sent < 60_000):
+            while sent < 10_500 or (process.poll() is None and sent < 70_000):
                 for publisher in publishers:
                     publisher.put(payloads[sent % len(payloads)])
                     sent += 1
@@ -242,9 +243,9 @@ def test_fuzzed_payloads_on_every_key_are_rejected_and_the_run_is_untouched(tmp_
     logger_counts = json.loads((out / "logs" / "logger.counts.json").read_text())
     # Every payload reached every subscriber of its key and was rejected there: none lost, none accepted.
     per_key = sent // len(targets)
-    assert logger_counts["rejected"] == 6 * per_key  # the logger listens on all six keys
-    assert counts["rejected"] == 4 * per_key  # deltas and states
-    assert all(c["rejected"] == 4 * per_key for c in agent_counts)  # deltas, objectives, control
+    assert logger_counts["rejected"] == 4 * per_key  # lockstep logger: go, two states, control
+    assert counts["rejected"] == 4 * per_key  # coordinator: two deltas, two states
+    assert all(c["rejected"] == 2 * per_key for c in agent_counts)  # lockstep agents: go, control
     reasons = {key for c in [counts, logger_counts, *agent_counts] for key in c if key.startswith("rejected.")}
     assert {"rejected.undecodable", "rejected.bad-version"} <= reasons
     (out / "fuzz.json").write_text(
@@ -322,9 +323,15 @@ def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_p
     team = unique_team()
     port = free_port()
     out = tmp_path / "run"
-    process = subprocess.Popen(launcher_command("--n", "4", "--seed", "0", "--clock", "realtime", "--speed", "40",
-                                                "--out", str(out), team=team, port=port),
-                               cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        launcher_command(
+            "--n", "4", "--seed", "0", "--clock", "realtime", "--speed", "40", "--out", str(out), team=team, port=port
+        ),
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     restarted = None
     try:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
@@ -332,10 +339,33 @@ def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_p
         os.kill(agent_pid(team, 1), signal.SIGKILL)
         time.sleep(1.0)
         restarted = subprocess.Popen(
-            [sys.executable, "-m", "anicov.cli", "agent", "--team", team, "--id", "1", "--n", "4", "--seed", "0",
-             "--clock", "realtime", "--speed", "40", "--connect", f"tcp/127.0.0.1:{port}",
-             "--counts", str(tmp_path / "restarted.json")], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-            text=True)
+            [
+                sys.executable,
+                "-m",
+                "anicov.cli",
+                "agent",
+                "--team",
+                team,
+                "--id",
+                "1",
+                "--n",
+                "4",
+                "--seed",
+                "0",
+                "--clock",
+                "realtime",
+                "--speed",
+                "40",
+                "--connect",
+                f"tcp/127.0.0.1:{port}",
+                "--counts",
+                str(tmp_path / "restarted.json"),
+            ],
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         stdout, stderr = process.communicate(timeout=400)
         _, restarted_log = restarted.communicate(timeout=60)
     finally:
