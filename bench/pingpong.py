@@ -38,7 +38,8 @@ def pong(endpoint: str) -> None:
             payload = sample.payload.to_bytes()
             if payload == b"stop":
                 done.put(True)
-            publisher.put(payload)
+            elif done.empty():
+                publisher.put(payload)
 
         session.declare_subscriber("bench/ping", echo)
         session.put("bench/ready", b"1")
