@@ -25,6 +25,7 @@ import logging
 import os
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import zenoh
 
@@ -268,14 +269,8 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         "bytes_sent": node.bytes_sent,
         "duplicates": node.replica.duplicates,
     }
-    write_counts(_path(options.counts_file), counts)
+    write_counts(Path(options.counts_file) if options.counts_file else None, counts)
     if node.finished is not None:
         log.info("agent %d: run %s at step %d", options.agent, node.finished.kind, node.finished.step)
         return EXIT_OK if node.finished.kind == "done" else EXIT_FAILED
     return stop.exit_code(EXIT_OK)
-
-
-def _path(name: str | None):
-    from pathlib import Path
-
-    return Path(name) if name else None

@@ -259,6 +259,16 @@ def _inflate(packed: Any, size: int, name: str) -> bytes:
     return raw
 
 
+def _members(body: dict[str, Any], last_agent: int) -> list[int]:
+    """A list of distinct agent ids in range."""
+    members = body.get("members")
+    if not isinstance(members, list) or any(isinstance(m, bool) or not isinstance(m, int) for m in members):
+        raise ProtocolError("bad-field", "members must be a list of integers")
+    if any(not 0 <= m <= last_agent for m in members) or len(set(members)) != len(members):
+        raise ProtocolError("out-of-range", "members must be distinct agent ids")
+    return members
+
+
 def _decode_delta(body: dict[str, Any], limits: Limits) -> MapDelta:
     last_agent = limits.agents - 1
     agent = _int(body, "agent", 0, last_agent)
@@ -281,11 +291,7 @@ def _decode_delta(body: dict[str, Any], limits: Limits) -> MapDelta:
 def _decode_objectives(body: dict[str, Any], limits: Limits) -> Objectives:
     last_agent = limits.agents - 1
     step = _int(body, "step", 0, MAX_STEP)
-    members = body.get("members")
-    if not isinstance(members, list) or any(isinstance(m, bool) or not isinstance(m, int) for m in members):
-        raise ProtocolError("bad-field", "members must be a list of integers")
-    if any(not 0 <= m <= last_agent for m in members) or len(set(members)) != len(members):
-        raise ProtocolError("out-of-range", "members must be distinct agent ids")
+    members = _members(body, last_agent)
     targets = _floats(body, "targets", 2 * len(members))
     blobs = _floats(body, "blobs")
     if len(blobs) % 2:
@@ -328,11 +334,7 @@ def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Messa
         return _decode_objectives(body, limits)
     if kind == "go":
         step = _int(body, "step", 0, MAX_STEP)
-        members = body.get("members")
-        if not isinstance(members, list) or any(isinstance(m, bool) or not isinstance(m, int) for m in members):
-            raise ProtocolError("bad-field", "members must be a list of integers")
-        if any(not 0 <= m <= last_agent for m in members) or len(set(members)) != len(members):
-            raise ProtocolError("out-of-range", "members must be distinct agent ids")
+        members = _members(body, last_agent)
         raw_deltas = body.get("deltas")
         if not isinstance(raw_deltas, list) or len(raw_deltas) > limits.agents:
             raise ProtocolError("bad-field", "deltas must be a list, at most one per agent")
