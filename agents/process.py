@@ -34,7 +34,7 @@ from agents.robot import Robot, SimulatedUnicycle
 from agents.step import LawParameters, decide_and_sense
 from anicov.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone
 from anicov.scenario import Scenario
-from protocol.bus import Inbox, Membership, Received, team_publisher, write_counts
+from protocol.bus import History, Inbox, LossTimer, Membership, Received, fetch, team_publisher, write_counts
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
@@ -204,11 +204,20 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         state_publisher = team_publisher(session, keys.agent_state(options.agent))
         token = session.liveliness().declare_token(keys.alive("agent", options.agent))
 
+        history = History()
+        session.declare_queryable(keys.agent_history(options.agent), history.serve)
+        loss = LossTimer()
+
         def publish(delta: MapDelta, state: AgentState) -> None:
             delta_bytes, state_bytes = encode(delta), encode(state)
             node.bytes_sent += len(delta_bytes) + len(state_bytes)
+            history.add(state.step, delta_bytes, state_bytes)
             delta_publisher.put(delta_bytes)
             state_publisher.put(state_bytes)
+
+        def recover_go() -> None:
+            """A go (or the end of the run) that should be here is not: ask the coordinator's history."""
+            fetch(session, keys.go_history, node.inbox, first=node.step)
 
         if node.resume_from_snapshot(session):
             if lockstep:
@@ -220,10 +229,14 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             log.info("agent %d resumes from the coordinator's snapshot at step %d", options.agent, node.step)
         # Wait for the first go, saying hello until the coordinator has heard it.
         next_hello = 0.0
+        hellos = 0
         while not node.started and node.finished is None and not stop.stopped:
             if time.monotonic() >= next_hello:
                 state_publisher.put(encode(node.hello()))
                 next_hello = time.monotonic() + HELLO_PERIOD
+                hellos += 1
+                if hellos % 5 == 0:
+                    recover_go()  # the first go may have been lost
             item = node.inbox.get(timeout=0.05)
             if item is not None:
                 node.handle(item)
@@ -235,17 +248,23 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         first_step = node.step
         while node.finished is None and not stop.stopped and not parent_is_gone(parent):
             if lockstep:
-                waiting_since = time.monotonic()
+                waiting_since = last_news = time.monotonic()
                 while not node.ready_for_step() and node.finished is None and not stop.stopped:
-                    item = node.inbox.get(timeout=0.5)
+                    item = node.inbox.get(timeout=loss.patience)
                     if item is not None:
                         node.handle(item)
+                        last_news = time.monotonic()
+                    elif time.monotonic() - last_news >= loss.patience:
+                        loss.recovering()
+                        recover_go()
+                        last_news = time.monotonic()
                     if time.monotonic() - waiting_since > 5.0:
                         log.info("agent %d still waiting at step %d: %s", options.agent, node.step, node.waiting_for())
                         waiting_since = time.monotonic()
                 if node.finished is not None or stop.stopped:
                     break
                 publish(*node.control_step())
+                loss.step_done()
             else:
                 while (item := node.inbox.get(timeout=0)) is not None:
                     node.handle(item)

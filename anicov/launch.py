@@ -70,6 +70,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--out", help="run directory (default runs/<date-time>)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--no-record", action="store_true", help="no logger, no OUT/recording.rrd")
+    parser.add_argument("--drop-rate", type=float, default=0.0, help=argparse.SUPPRESS)  # test hook: loss
     parser.add_argument("--viewer", action="store_true", help="spawn a live rerun viewer")
     parser.add_argument("--serve", action="store_true", help="serve a web viewer (for a browser on another machine)")
     parser.add_argument("--map-every", type=int, default=50, help="log the map every K steps (default 50)")
@@ -96,6 +97,7 @@ def child_command(role: str, args: argparse.Namespace, extra: list[str]) -> list
         ("--n", args.n),
         ("--seed", args.seed),
         ("--controller", args.controller),
+        ("--drop-rate", args.drop_rate or None),
     ):
         if value is not None:
             command += [flag, str(value)]

@@ -24,7 +24,7 @@ import zenoh
 from anicov.engine import SNAPSHOT_PERIOD, TRACE_FIELDS, Planner, RunResult
 from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone
 from anicov.scenario import Scenario
-from protocol.bus import Inbox, Membership, Received, team_publisher, write_counts
+from protocol.bus import History, Inbox, LossTimer, Membership, Received, fetch, team_publisher, write_counts
 from protocol.keys import TeamKeys
 from protocol.messages import AgentState, Limits, MapDelta, Objectives, RunControl, StepGo, encode
 from protocol.replica import MapReplica
@@ -187,6 +187,14 @@ class Coordinator:
             )
         return Objectives(step, tuple(members), self.targets, self.planner.blobs.positions)
 
+    def missing(self, step: int) -> list[int]:
+        """Members whose delta or state of ``step`` has not arrived."""
+        return [
+            agent
+            for agent in sorted(self.members)
+            if not self.replica.has(agent, step) or self.latest_state_step.get(agent, -2) < step
+        ]
+
     def step_complete(self, step: int) -> bool:
         """Lockstep: every member's delta and state of ``step`` are in."""
         return all(
@@ -234,6 +242,15 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         session.declare_queryable(keys.snapshot, lambda query: query.reply(keys.snapshot, node.snapshot_payload()))
         objectives_publisher = team_publisher(session, keys.objectives)
         go_publisher = team_publisher(session, keys.go)
+        go_history = History()
+        loss = LossTimer()
+        session.declare_queryable(keys.go_history, go_history.serve)
+
+        def publish_go(go: StepGo) -> None:
+            payload = encode(go)
+            go_history.add(go.step, payload)
+            publish(go_publisher, payload)
+
         control_publisher = team_publisher(session, keys.control)
         status_publisher = team_publisher(session, keys.status)
         token = session.liveliness().declare_token(keys.alive("coordinator"))
@@ -261,10 +278,10 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         snapshot_steps = max(1, round(SNAPSHOT_PERIOD / scenario.dt))
         last_status = 0.0
         step = 0
-        started = time.monotonic()
+        started = last_news = time.monotonic()
         next_plan = started
         if lockstep:
-            publish(go_publisher, encode(node.go(0, [])))
+            publish_go(node.go(0, []))
         else:
             publish(objectives_publisher, encode(node.plan(0)))
         while outcome is None and not stop.stopped:
@@ -274,12 +291,20 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             if lockstep:
                 # Close steps in order as their deltas and states come in; each closed step k−1
                 # becomes the go for step k, carrying every member's delta of step k−1.
-                item = node.inbox.get(timeout=0.5)
+                item = node.inbox.get(timeout=loss.patience)
                 if item is not None:
                     node.handle(item)
+                    last_news = time.monotonic()
+                elif time.monotonic() - last_news >= loss.patience:
+                    loss.recovering()
+                    # Something of this step is missing (lost on the way): ask its sender's history.
+                    for agent in node.missing(step):
+                        fetch(session, keys.agent_history(agent), node.inbox, first=step, last=step)
+                    last_news = time.monotonic()
                 while outcome is None and node.step_complete(step):
                     # The replica now holds exactly Λ_{k+1}: every delta of steps ≤ k, none later.
                     step += 1
+                    loss.step_done()
                     node.log.errors.append(node.replica.map.domain_error())
                     if step % snapshot_steps == 0:
                         node.take_snapshot(step * scenario.dt)
@@ -287,9 +312,9 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                         outcome = (step, node.replica.map.complete, step)
                         # The last go only completes every replica; the agents then wait for the end.
                         last = tuple(node.open_next_step())
-                        publish(go_publisher, encode(StepGo(step, tuple(sorted(node.members)), last)))
+                        publish_go(StepGo(step, tuple(sorted(node.members)), last))
                         break
-                    publish(go_publisher, encode(node.go(step, node.open_next_step())))
+                    publish_go(node.go(step, node.open_next_step()))
             else:
                 item = node.inbox.get(timeout=0.01)
                 while item is not None:
@@ -323,7 +348,9 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                 last_status = now
         if outcome is not None:
             steps, completed, completion_step = outcome
-            publish(control_publisher, encode(RunControl("done", steps, completed, node.replica.map.domain_error())))
+            done = encode(RunControl("done", steps, completed, node.replica.map.domain_error()))
+            go_history.final = [done]  # an agent that lost the end of the run finds it here
+            publish(control_publisher, done)
             log.info(
                 "run %s after %d steps (e_D = %.4f)",
                 "complete" if completed else "incomplete",

@@ -80,6 +80,88 @@ class Received:
     message: Message
 
 
+class History:
+    """The last ``capacity`` steps of what a process published, served to whoever lost some of it.
+
+    Zenoh delivers reliably on a healthy link, but a link can drop, a process
+    can be slow to subscribe, and the tests inject loss on purpose: a receiver
+    that notices a missing step asks the sender's history queryable for it.
+    """
+
+    def __init__(self, capacity: int = 20_000) -> None:
+        self.capacity = capacity
+        self._items: dict[int, list[bytes]] = {}
+        self._lock = threading.Lock()
+        self.final: list[bytes] = []  # sent with every reply once set (the end of the run)
+
+    def add(self, step: int, *payloads: bytes) -> None:
+        with self._lock:
+            self._items[step] = list(payloads)
+            if len(self._items) > self.capacity:
+                del self._items[min(self._items)]
+
+    def between(self, first: int, last: int) -> list[bytes]:
+        with self._lock:
+            steps = [step for step in self._items if first <= step <= last]
+            return [payload for step in sorted(steps) for payload in self._items[step]] + list(self.final)
+
+    def serve(self, query: zenoh.Query) -> None:
+        """Reply to ``?from=K;to=L`` (both optional) with every payload kept for those steps."""
+        parameters = query.parameters
+        try:
+            first = int(parameters.get("from") or 0)
+            last = int(parameters.get("to") or 2**62)
+        except ValueError:
+            return
+        for payload in self.between(first, last):
+            query.reply(query.key_expr, payload)
+
+
+class LossTimer:
+    """When silence means loss: a few times the usual step time, never under a floor.
+
+    A busy machine (thirty processes on two cores) makes every step slow;
+    recovering after a fixed short silence would then flood histories with
+    queries for messages that are only late.
+    """
+
+    def __init__(self, floor: float = 0.05, factor: float = 5.0) -> None:
+        self.floor = floor
+        self.factor = factor
+        self.typical = floor / factor
+        self._last = time.monotonic()
+        self._clean = True
+
+    def recovering(self) -> None:
+        """A fetch was needed: this step's time says nothing about the usual pace."""
+        self._clean = False
+
+    def step_done(self) -> None:
+        now = time.monotonic()
+        if self._clean:  # learning from steps slowed by a loss would feed back into ever longer waits
+            self.typical = 0.9 * self.typical + 0.1 * (now - self._last)
+        self._last = now
+        self._clean = True
+
+    @property
+    def patience(self) -> float:
+        return max(self.floor, self.factor * self.typical)
+
+
+def fetch(
+    session: zenoh.Session, key: str, inbox: Inbox, first: int, last: int | None = None, timeout: float = 1.0
+) -> int:
+    """Ask a history queryable for steps first..last; replies go through the inbox's validation."""
+    selector = f"{key}?from={first}" + (f";to={last}" if last is not None else "")
+    count = 0
+    # No consolidation: a history replies several payloads on one key (Zenoh would keep only the last).
+    for reply in session.get(selector, timeout=timeout, consolidation=zenoh.ConsolidationMode.NONE):
+        if reply.ok is not None:
+            inbox.deliver(str(reply.ok.key_expr), reply.ok.payload.to_bytes())
+            count += 1
+    return count
+
+
 @dataclass(frozen=True)
 class _Raw:
     key: str
@@ -109,6 +191,7 @@ class Inbox:
         self._drop_rate = drop_rate
         self._drop_random = __import__("random").Random(seed)
         self.dropped = 0
+        self.recovered = 0
 
     def on_sample(self, sample: zenoh.Sample) -> None:
         key = str(sample.key_expr)
@@ -125,6 +208,14 @@ class Inbox:
         if self.defer_decoding:
             self.queue.put(_Raw(key, payload))
             return
+        received = self._validate(key, payload)
+        if received is not None:
+            self.queue.put(received)
+
+    def deliver(self, key: str, payload: bytes) -> None:
+        """A payload fetched by a query (not subject to the drop hook): validate and queue it."""
+        with self._lock:
+            self.recovered += 1
         received = self._validate(key, payload)
         if received is not None:
             self.queue.put(received)
@@ -178,6 +269,7 @@ class Inbox:
                 "accepted": self.accepted,
                 "rejected": sum(self.rejected.values()),
                 "dropped": self.dropped,
+                "recovered": self.recovered,
                 "bytes_received": self.bytes_received,
                 **{f"rejected.{k}": v for k, v in self.rejected.items()},
             }

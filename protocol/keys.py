@@ -1,12 +1,17 @@
 """Zenoh key expressions of a team. Everything lives under ``anicov/<team>/``.
 
-anicov/<team>/agent/<id>/delta        MapDelta      agent → all      coverage it added in one step
-anicov/<team>/agent/<id>/state        AgentState    agent → all      pose, (v, ω), e_Ω of one step
-anicov/<team>/coordinator/objectives  Objectives    coordinator → all  go for step k, with targets
-anicov/<team>/coordinator/snapshot    (queryable)   coordinator      map + last sequences, for late joiners
-anicov/<team>/run/control             RunControl    coordinator → all  run done / aborted
-anicov/<team>/run/status              RunControl    coordinator → all  progress (e_D, step)
-anicov/<team>/alive/<role>/<id>       liveliness tokens: agent/<id>, coordinator/0, logger/0
+key (under anicov/<team>/)  message              from → to           what
+agent/<id>/delta            MapDelta             agent → all         coverage it added in one step
+agent/<id>/state            AgentState           agent → all         pose, (v, ω), e_Ω of one step
+agent/<id>/history          (queryable)          agent               its recent deltas and states
+coordinator/go              StepGo               coordinator → all   lockstep: step k may start, with
+                                                                     every step k−1 delta, targets on replans
+coordinator/objectives      Objectives           coordinator → all   realtime: the latest targets
+coordinator/snapshot        (queryable)          coordinator         map, sequences, poses: late joiners
+coordinator/history         (queryable)          coordinator         recent gos and the end of the run
+run/control                 RunControl           coordinator → all   run done / aborted
+run/status                  RunControl           coordinator → all   progress (e_D, step)
+alive/<role>/<id>           liveliness token     every process       agent/<id>, coordinator/0, logger/0
 """
 
 from __future__ import annotations
@@ -41,6 +46,13 @@ class TeamKeys:
 
     def agent_state(self, agent: int) -> str:
         return f"{self.prefix}/agent/{agent}/state"
+
+    def agent_history(self, agent: int) -> str:
+        return f"{self.prefix}/agent/{agent}/history"
+
+    @property
+    def go_history(self) -> str:
+        return f"{self.prefix}/coordinator/history"
 
     @property
     def all_deltas(self) -> str:
