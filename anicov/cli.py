@@ -163,6 +163,24 @@ def command_router(args: argparse.Namespace) -> int:
     return stop.exit_code(EXIT_OK)
 
 
+def command_certs(args: argparse.Namespace) -> int:
+    from anicov.secure import DEFAULT_HOSTS, make_profile
+
+    profile = make_profile(
+        Path(args.out),
+        args.n,
+        team=args.team,
+        hosts=tuple(args.host or DEFAULT_HOSTS),
+        endpoint=args.endpoint,
+        days=args.days,
+    )
+    print(f"anicov certs: CA, {len(profile.roles)} certificates and Zenoh configs in {profile.directory}")
+    print(f"  router:  anicov router --zenoh-config {profile.config('router')}")
+    print(f"  agent i: anicov agent --team {args.team} --id i --zenoh-config {profile.directory}/agent-i.json5 ...")
+    print(f"  a whole team here: launch_team.py --n {args.n} --team {args.team} --secure {profile.directory}")
+    return EXIT_OK
+
+
 def command_launch(args: argparse.Namespace) -> int:
     from anicov.launch import main as launch_main
 
@@ -242,6 +260,21 @@ def build_parser() -> argparse.ArgumentParser:
     router.add_argument("--listen", action="append", help="endpoint (repeatable), e.g. tcp/0.0.0.0:7447")
     router.add_argument("--zenoh-config", help="a Zenoh JSON5 config file (see deploy/router.json5)")
     router.set_defaults(handler=command_router)
+
+    certs = commands.add_parser(
+        "certs", help="a secure profile: test CA, per-process certificates, mutual-TLS and access-control configs"
+    )
+    certs.add_argument("--out", required=True, help="directory for the profile (keys are written mode 0600)")
+    certs.add_argument("--n", type=int, default=4, help="team size: certificates agent-0 .. agent-(n-1) (default 4)")
+    certs.add_argument("--team", default="team", help="the team the access-control list admits (default team)")
+    certs.add_argument(
+        "--host",
+        action="append",
+        help="router host name or IP in its certificate (repeatable; default localhost, 127.0.0.1)",
+    )
+    certs.add_argument("--endpoint", default="tls/localhost:7447", help="router endpoint (default tls/localhost:7447)")
+    certs.add_argument("--days", type=int, default=365, help="validity in days (default 365)")
+    certs.set_defaults(handler=command_certs)
 
     launch = commands.add_parser("launch", help="a whole team on this machine (same as launch_team.py)", add_help=False)
     launch.add_argument("rest", nargs=argparse.REMAINDER)

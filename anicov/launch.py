@@ -65,7 +65,15 @@ def add_team_arguments(parser: argparse.ArgumentParser) -> None:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="launch_team.py", description=__doc__.split("\n\n")[0])
     add_team_arguments(parser)
-    parser.add_argument("--listen", default="tcp/127.0.0.1:7447", help="router endpoint (default tcp/127.0.0.1:7447)")
+    parser.add_argument(
+        "--listen",
+        help="router endpoint (default tcp/127.0.0.1:7447, or the --secure profile's tls endpoint)",
+    )
+    parser.add_argument(
+        "--secure",
+        metavar="DIR",
+        help="mutual TLS and access control from a profile made by 'anicov certs --out DIR'",
+    )
     parser.add_argument("--team", default="team", help="team name: keys live under anicov/<team>/")
     parser.add_argument("--out", help="run directory (default runs/<date-time>)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -77,7 +85,8 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def child_command(role: str, args: argparse.Namespace, extra: list[str]) -> list[str]:
+def child_command(role: str, args: argparse.Namespace, extra: list[str], identity: str | None = None) -> list[str]:
+    """The command line of one child; ``identity`` names its certificate and config in a --secure profile."""
     command = [
         sys.executable,
         "-m",
@@ -98,6 +107,7 @@ def child_command(role: str, args: argparse.Namespace, extra: list[str]) -> list
         ("--seed", args.seed),
         ("--controller", args.controller),
         ("--drop-rate", args.drop_rate or None),
+        ("--zenoh-config", str(Path(args.secure).resolve() / f"{identity or role}.json5") if args.secure else None),
     ):
         if value is not None:
             command += [flag, str(value)]
@@ -187,6 +197,18 @@ def main(argv: list[str] | None = None) -> int:
     except ScenarioError as error:
         print(f"launch_team: error: {error}", file=sys.stderr)
         return EXIT_USAGE
+    router_config_file = None
+    if args.secure:
+        from anicov.secure import load_profile
+
+        try:
+            profile, endpoint = load_profile(Path(args.secure), args.team, scenario.agents)
+        except ValueError as error:
+            print(f"launch_team: error: {error}", file=sys.stderr)
+            return EXIT_USAGE
+        router_config_file = str(profile.config("router"))
+        args.listen = args.listen or endpoint
+    args.listen = args.listen or "tcp/127.0.0.1:7447"
     out_dir = Path(args.out or Path("runs") / datetime.now().strftime("%Y%m%d-%H%M%S"))
     out_dir.mkdir(parents=True, exist_ok=True)
     logs = out_dir / "logs"
@@ -216,7 +238,7 @@ def main(argv: list[str] | None = None) -> int:
     children: list[Child] = []
     exit_code = EXIT_FAILED
     try:
-        router = zenoh.open(zenoh_config("router", listen=[args.listen]))
+        router = zenoh.open(zenoh_config("router", listen=[args.listen], config_file=router_config_file))
     except zenoh.ZError as error:
         print(f"launch_team: error: cannot open the router on {args.listen}: {error}", file=sys.stderr)
         return EXIT_USAGE
@@ -240,7 +262,8 @@ def main(argv: list[str] | None = None) -> int:
             wait_for_token(router, keys.alive("logger"), timeout=60.0)
         for agent in range(scenario.agents):
             agent_flags = ["--id", str(agent), "--counts", str(logs / f"agent-{agent}.counts.json")]
-            children.append(spawn(f"agent-{agent}", child_command("agent", args, agent_flags), logs))
+            name = f"agent-{agent}"
+            children.append(spawn(name, child_command("agent", args, agent_flags, identity=name), logs))
         bar = tqdm(total=100, desc=f"team of {scenario.agents}", unit="%", disable=args.quiet or None)
         coordinator = children[0]
         reported: set[str] = set()
