@@ -34,7 +34,18 @@ from agents.robot import Robot, SimulatedUnicycle
 from agents.step import LawParameters, decide_and_sense
 from anicov.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone
 from anicov.scenario import Scenario
-from protocol.bus import History, Inbox, LossTimer, Membership, Received, fetch, team_publisher, write_counts
+from protocol.bus import (
+    GAP_CHECK_PERIOD,
+    History,
+    Inbox,
+    LossTimer,
+    Membership,
+    Received,
+    fetch,
+    fill_gaps,
+    team_publisher,
+    write_counts,
+)
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
@@ -52,6 +63,8 @@ from protocol.replica import MapReplica
 
 log = logging.getLogger("anicov.agent")
 
+END_ONLY = 2**60
+"""A history query from this step returns no step, only the end of the run once it is known."""
 HELLO_PERIOD = 0.2
 """Seconds between repeated hellos until the coordinator's first go arrives."""
 
@@ -104,6 +117,14 @@ class AgentNode:
             self.started = True
         elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
             self.finished = message
+
+    def drain(self, seconds: float) -> None:
+        """After the end of the run: take in what is still arriving for ``seconds``."""
+        until = time.monotonic() + seconds
+        while self.finished is not None and time.monotonic() < until:
+            item = self.inbox.get(timeout=0.05)
+            if item is not None:
+                self.handle(item)
 
     def apply_remaining_gos(self) -> None:
         """At the end of a run: the last go completes the map even if the end arrived first."""
@@ -204,7 +225,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         state_publisher = team_publisher(session, keys.agent_state(options.agent))
         token = session.liveliness().declare_token(keys.alive("agent", options.agent))
 
-        history = History()
+        history = History(keys.agent_history(options.agent))
         session.declare_queryable(keys.agent_history(options.agent), history.serve)
         loss = LossTimer()
 
@@ -245,6 +266,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         log.info("agent %d starts (%s clock)", options.agent, options.clock)
         period = scenario.dt / options.speed
         started = time.monotonic()
+        next_gap_check = started + GAP_CHECK_PERIOD
         first_step = node.step
         while node.finished is None and not stop.stopped and not parent_is_gone(parent):
             if lockstep:
@@ -270,16 +292,22 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
                     node.handle(item)
                 if node.finished is not None:
                     break
+                if time.monotonic() >= next_gap_check:
+                    fill_gaps(session, keys, node.replica, node.inbox)  # teammates' deltas lost on the way
+                    fetch(session, keys.go_history, node.inbox, first=END_ONLY)  # the end of the run, if lost
+                    next_gap_check = time.monotonic() + GAP_CHECK_PERIOD
                 publish(*node.control_step())
                 wait = started + (node.step - first_step) * period - time.monotonic()
                 if wait > 0:
                     stop.wait(wait)
         # Let in-flight deltas of teammates land, so every replica ends with the same map.
-        drain_until = time.monotonic() + 0.5
-        while node.finished is not None and time.monotonic() < drain_until:
-            item = node.inbox.get(timeout=0.05)
-            if item is not None:
-                node.handle(item)
+        node.drain(0.5)
+        if node.finished is not None and not lockstep:
+            # Realtime: the last deltas of a teammate have no later one to reveal their loss; ask every
+            # history for what follows our contiguous run, then stay a moment to answer the others' asks.
+            teammates = [agent for agent in range(scenario.agents) if agent != options.agent]
+            fill_gaps(session, keys, node.replica, node.inbox, to_the_end=teammates)
+            node.drain(0.5)
         node.apply_remaining_gos()
         token.undeclare()
     counts = node.inbox.counts() | {
@@ -287,6 +315,8 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         "steps": node.step,
         "bytes_sent": node.bytes_sent,
         "duplicates": node.replica.duplicates,
+        "applied": node.replica.contiguous(),
+        "gaps": sum(len(missing) for missing in node.replica.gaps().values()),
     }
     write_counts(Path(options.counts_file) if options.counts_file else None, counts)
     if node.finished is not None:

@@ -34,6 +34,8 @@ log = logging.getLogger("anicov.launch")
 
 GRACE_SECONDS = 10.0
 """How long children get to exit after SIGTERM before SIGKILL."""
+COORDINATOR_RESTARTS = 3
+"""How many times a coordinator killed by a signal is started again (it resumes from the agents)."""
 
 
 @dataclass
@@ -245,7 +247,8 @@ def main(argv: list[str] | None = None) -> int:
     with router:
         router.declare_subscriber(keys.control, on_control)
         router.declare_subscriber(keys.status, on_control)
-        children.append(spawn("coordinator", child_command("coordinator", args, ["--out", str(out_dir)]), logs))
+        coordinator_command = child_command("coordinator", args, ["--out", str(out_dir)])
+        children.append(spawn("coordinator", coordinator_command, logs))
         if not args.no_record or args.viewer or args.serve:
             logger_flags = [
                 "--out",
@@ -268,6 +271,7 @@ def main(argv: list[str] | None = None) -> int:
         coordinator = children[0]
         reported: set[str] = set()
         lost: list[str] = []
+        restarts = 0
         try:
             while not stop.stopped:
                 status = latest.get("status")
@@ -275,6 +279,13 @@ def main(argv: list[str] | None = None) -> int:
                     bar.set_postfix_str(f"t={status.step * scenario.dt:.0f}", refresh=False)
                     bar.update(max(0, round(100 * (1 - status.domain_error)) - bar.n))
                 code = coordinator.process.poll()
+                if code is not None and code < 0 and restarts < COORDINATOR_RESTARTS:
+                    # Killed, not finished: a new coordinator rebuilds the run from the agents' histories.
+                    restarts += 1
+                    log.warning("the coordinator was killed (signal %d); starting it again (%d)", -code, restarts)
+                    coordinator = spawn(f"coordinator.restart-{restarts}", coordinator_command, logs)
+                    children[0] = coordinator
+                    continue
                 if code is not None:
                     exit_code = code
                     break
@@ -312,6 +323,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         if lost:
             print(f"  lost on the way {', '.join(lost)} (the team completed without them)")
+        if restarts:
+            print(f"  coordinator     killed and restarted {restarts} time(s); it resumed from the agents' histories")
         if (out_dir / "recording.rrd").exists():
             print(f"  recording       {out_dir / 'recording.rrd'}   (anicov replay {out_dir / 'recording.rrd'})")
         print(f"  wall time       {time.monotonic() - started:.1f} s")

@@ -24,7 +24,18 @@ import zenoh
 from anicov.engine import SNAPSHOT_PERIOD, TRACE_FIELDS, Planner, RunResult
 from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone
 from anicov.scenario import Scenario
-from protocol.bus import History, Inbox, LossTimer, Membership, Received, fetch, team_publisher, write_counts
+from protocol.bus import (
+    GAP_CHECK_PERIOD,
+    History,
+    Inbox,
+    LossTimer,
+    Membership,
+    Received,
+    fetch,
+    fill_gaps,
+    team_publisher,
+    write_counts,
+)
 from protocol.keys import TeamKeys
 from protocol.messages import AgentState, Limits, MapDelta, Objectives, RunControl, StepGo, encode
 from protocol.replica import MapReplica
@@ -33,6 +44,8 @@ log = logging.getLogger("anicov.coordinator")
 
 START_TIMEOUT = 120.0
 """Seconds to wait for every agent's hello before giving up."""
+HISTORY_TIMEOUT = 30.0
+"""Seconds a restarted coordinator waits for the agents' full histories (a long run has many steps)."""
 STATUS_PERIOD = 0.25
 """Seconds between progress messages on run/status."""
 
@@ -201,6 +214,66 @@ class Coordinator:
             self.replica.has(agent, step) and self.latest_state_step.get(agent, -2) >= step for agent in self.members
         )
 
+    def rebuild(self, messages: list[MapDelta | AgentState], members: set[int]) -> int:
+        """A restarted coordinator: replay the agents' histories as the lost coordinator lived them.
+
+        Step by step from 0, the deltas of step s−1 enter the replica (Λ_s), e_D
+        and the map snapshots are logged, the states of step s are recorded and,
+        in lockstep on a replanning step, the planner runs on Λ_s and the poses
+        of step s, so its memory of blobs is the one the lost coordinator had.
+        Returns the step to resume at: the latest step every member has
+        published. In lockstep that step is still open (its deltas go into the
+        next go), so a run that lost its coordinator still equals the engine.
+        """
+        deltas: dict[int, list[MapDelta]] = {}
+        states: dict[int, list[AgentState]] = {}
+        for message in messages:
+            if isinstance(message, MapDelta) and message.agent in members:
+                deltas.setdefault(message.seq, []).append(message)
+            elif isinstance(message, AgentState) and message.step >= 0 and message.agent in members:
+                states.setdefault(message.step, []).append(message)
+        latest: dict[int, int] = {}
+        for step, of_step in states.items():
+            for state in of_step:
+                latest[state.agent] = max(latest.get(state.agent, -1), step)
+        resume = min(latest.values())
+        snapshot_steps = max(1, round(SNAPSHOT_PERIOD / self.scenario.dt))
+        lockstep = self.open_step is not None
+        with self.lock:
+            self.members = set(latest)
+            for step in range(resume + 1):
+                if step > 0:
+                    for delta in deltas.get(step - 1, []):
+                        self.replica.apply(delta)
+                    self.log.errors.append(self.replica.map.domain_error())
+                if step % snapshot_steps == 0:
+                    self.take_snapshot(step * self.scenario.dt)
+                for state in states.get(step, []):
+                    self.log.record(state)
+                    self.positions[state.agent] = (state.pose[0], state.pose[1])
+                if lockstep and step % self.scenario.replan_steps == 0:
+                    self.plan(step)
+                for state in states.get(step, []):
+                    self.latest_state_step[state.agent] = step
+                    self.positions[state.agent] = (state.next_pose[0], state.next_pose[1])
+            if lockstep:
+                self.open_step = resume
+            # What lies beyond: the open step's deltas (for the next go) and any later ones.
+            for message in messages:
+                if isinstance(message, MapDelta) and message.seq >= resume and message.agent in members:
+                    self._handle(Received("", message))
+                elif isinstance(message, AgentState) and message.step > resume and message.agent in members:
+                    self._handle(Received("", message))
+        return resume
+
+    def drain(self, seconds: float) -> None:
+        """After the end of the run: take in what is still arriving for ``seconds``."""
+        until = time.monotonic() + seconds
+        while time.monotonic() < until:
+            item = self.inbox.get(timeout=0.05)
+            if item is not None:
+                self.handle(item)
+
     def take_snapshot(self, time_now: float) -> None:
         lack = self.replica.map.lack_of_coverage()
         self.log.snapshot_times.append(time_now)
@@ -242,7 +315,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         session.declare_queryable(keys.snapshot, lambda query: query.reply(keys.snapshot, node.snapshot_payload()))
         objectives_publisher = team_publisher(session, keys.objectives)
         go_publisher = team_publisher(session, keys.go)
-        go_history = History()
+        go_history = History(keys.go_history)
         loss = LossTimer()
         session.declare_queryable(keys.go_history, go_history.serve)
 
@@ -259,30 +332,60 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             node.bytes_sent += len(payload)
             publisher.put(payload)
 
-        # Wait until every agent has said hello (its pose at t_0).
+        # Wait until every agent has said hello (its pose at t_0), unless the team is already running:
+        # then this coordinator replaces one that died, and rebuilds from the agents' histories.
+        running: list[MapDelta | AgentState] = []
         deadline = time.monotonic() + START_TIMEOUT
-        while len(node.positions) < scenario.agents and not stop.stopped and time.monotonic() < deadline:
+        next_look = 0.0
+        while len(node.positions) < scenario.agents and not running and not stop.stopped:
+            if time.monotonic() >= next_look:  # lockstep agents that lost their coordinator wait in silence
+                fetch(session, keys.all_histories, node.inbox, first=0, last=0, timeout=0.5)
+                next_look = time.monotonic() + 0.5
             item = node.inbox.get(timeout=0.1)
             if item is not None:
-                node.handle(item)
-            if parent_is_gone(parent):
-                stop.set()
-        if len(node.positions) < scenario.agents:
+                if is_running(item):
+                    running.append(item.message)  # type: ignore[union-attr]
+                else:
+                    node.handle(item)
+            if parent_is_gone(parent) or time.monotonic() > deadline:
+                break
+        step = 0
+        if running:
+            # Ends when every history has replied in full; live messages keep coming meanwhile,
+            # so take only what is queued then: the rest is for the main loop.
+            fetch(session, keys.all_histories, node.inbox, first=0, timeout=HISTORY_TIMEOUT)
+            for _ in range(node.inbox.queue.qsize()):
+                item = node.inbox.get(timeout=0)
+                if item is None:
+                    break
+                if is_running(item):
+                    running.append(item.message)  # type: ignore[union-attr]
+                else:
+                    node.handle(item)
+            step = node.rebuild(running, node.alive & set(range(scenario.agents)))
+            node.log.events.append(f"coordinator resumed at step {step}")
+            log.warning(
+                "a running team: resumed at step %d from the histories of agents %s", step, sorted(node.members)
+            )
+        elif len(node.positions) < scenario.agents:
             log.error("only %d of %d agents said hello; giving up", len(node.positions), scenario.agents)
             publish(control_publisher, encode(RunControl("abort", 0, reason="agents missing at start")))
             token.undeclare()
             return stop.exit_code(EXIT_FAILED)
-        node.members = set(range(scenario.agents))
-        log.info("all %d agents present; starting (%s clock)", scenario.agents, options.clock)
-        node.take_snapshot(0.0)
+        else:
+            node.members = set(range(scenario.agents))
+            log.info("all %d agents present; starting (%s clock)", scenario.agents, options.clock)
+            node.take_snapshot(0.0)
         snapshot_steps = max(1, round(SNAPSHOT_PERIOD / scenario.dt))
         last_status = 0.0
-        step = 0
-        started = last_news = time.monotonic()
-        next_plan = started
-        if lockstep:
+        step_resumed = step if running else None
+        began = last_news = time.monotonic()
+        started = began - step * scenario.dt / options.speed  # realtime: the wall-clock time of step 0
+        next_plan = time.monotonic()
+        next_gap_check = next_plan + GAP_CHECK_PERIOD
+        if lockstep and not running:
             publish_go(node.go(0, []))
-        else:
+        elif not lockstep:
             publish(objectives_publisher, encode(node.plan(0)))
         while outcome is None and not stop.stopped:
             if parent_is_gone(parent):
@@ -320,6 +423,9 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                 while item is not None:
                     node.handle(item)
                     item = node.inbox.get(timeout=0)
+                if time.monotonic() >= next_gap_check:
+                    fill_gaps(session, keys, node.replica, node.inbox)
+                    next_gap_check = time.monotonic() + GAP_CHECK_PERIOD
                 reached = max(node.latest_state_step.values(), default=-1) + 1
                 while len(node.log.errors) <= reached:
                     node.log.errors.append(node.replica.map.domain_error())
@@ -364,19 +470,22 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             )
         # Deltas still in flight (realtime agents step until they hear the end) join the map.
         node.open_step = None
-        drain_until = time.monotonic() + 0.5
-        while time.monotonic() < drain_until:
-            item = node.inbox.get(timeout=0.05)
-            if item is not None:
-                node.handle(item)
+        node.drain(0.5)
+        if outcome is not None:
+            publish(control_publisher, done)  # again, for whoever lost the first (it is idempotent)
+        if not lockstep:  # and those lost on the way, last ones included (see fill_gaps)
+            fill_gaps(session, keys, node.replica, node.inbox, to_the_end=range(scenario.agents))
+            node.drain(0.5)
         token.undeclare()
         counts = node.inbox.counts() | {
             "map_digest": node.replica.digest(),
             "bytes_sent": node.bytes_sent,
             "duplicates": node.replica.duplicates,
             "gaps": sum(len(v) for v in node.replica.gaps().values()),
-            "wall_seconds": time.monotonic() - started,
+            "applied": node.replica.contiguous(),
+            "wall_seconds": time.monotonic() - began,
             "events": node.log.events,
+            "resumed_at": step_resumed,
         }
         if outcome is not None and options.out:
             # Still on the bus while writing: a late logger can fetch the final map's snapshot.
@@ -385,6 +494,13 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
     if outcome is None:
         return stop.exit_code(EXIT_FAILED)
     return EXIT_OK if outcome[1] else EXIT_INCOMPLETE
+
+
+def is_running(item: Received | Membership) -> bool:
+    """A delta, or a state of a step already taken: the team is past its hellos."""
+    if not isinstance(item, Received):
+        return False
+    return isinstance(item.message, MapDelta) or (isinstance(item.message, AgentState) and item.message.step >= 0)
 
 
 def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, object]) -> None:

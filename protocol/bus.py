@@ -14,13 +14,15 @@ import queue
 import threading
 import time
 from collections import Counter
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
 import zenoh
 
-from protocol.keys import agent_of_key
+from protocol.keys import TeamKeys, agent_of_key
 from protocol.messages import Limits, Message, ProtocolError, decode
+from protocol.replica import MapReplica
 
 log = logging.getLogger("anicov.bus")
 
@@ -80,6 +82,10 @@ class Received:
     message: Message
 
 
+MAX_STEPS_ASKED = 2000
+"""The most single steps one history query may name (a selector must stay a reasonable size)."""
+
+
 class History:
     """The last ``capacity`` steps of what a process published, served to whoever lost some of it.
 
@@ -88,7 +94,8 @@ class History:
     that notices a missing step asks the sender's history queryable for it.
     """
 
-    def __init__(self, capacity: int = 20_000) -> None:
+    def __init__(self, key: str, capacity: int = 20_000) -> None:
+        self.key = key  # replies name this key, never the query's (which may be a wildcard)
         self.capacity = capacity
         self._items: dict[int, list[bytes]] = {}
         self._lock = threading.Lock()
@@ -105,16 +112,26 @@ class History:
             steps = [step for step in self._items if first <= step <= last]
             return [payload for step in sorted(steps) for payload in self._items[step]] + list(self.final)
 
+    def at(self, steps: list[int]) -> list[bytes]:
+        with self._lock:
+            return [payload for step in sorted(set(steps)) for payload in self._items.get(step, [])]
+
     def serve(self, query: zenoh.Query) -> None:
-        """Reply to ``?from=K;to=L`` (both optional) with every payload kept for those steps."""
+        """Reply to ``?from=K;to=L`` (both optional) or ``?steps=K,L,…`` with every payload kept for
+        those steps. A malformed selector gets no reply."""
         parameters = query.parameters
         try:
-            first = int(parameters.get("from") or 0)
-            last = int(parameters.get("to") or 2**62)
+            if parameters.get("steps"):
+                steps = [int(step) for step in str(parameters.get("steps")).split(",")[:MAX_STEPS_ASKED]]
+                payloads = self.at(steps)
+            else:
+                first = int(parameters.get("from") or 0)
+                last = int(parameters.get("to") or 2**62)
+                payloads = self.between(first, last)
         except ValueError:
             return
-        for payload in self.between(first, last):
-            query.reply(query.key_expr, payload)
+        for payload in payloads:
+            query.reply(self.key, payload)
 
 
 class LossTimer:
@@ -149,10 +166,20 @@ class LossTimer:
 
 
 def fetch(
-    session: zenoh.Session, key: str, inbox: Inbox, first: int, last: int | None = None, timeout: float = 1.0
+    session: zenoh.Session,
+    key: str,
+    inbox: Inbox,
+    first: int = 0,
+    last: int | None = None,
+    timeout: float = 1.0,
+    steps: list[int] | None = None,
 ) -> int:
-    """Ask a history queryable for steps first..last; replies go through the inbox's validation."""
-    selector = f"{key}?from={first}" + (f";to={last}" if last is not None else "")
+    """Ask a history queryable for steps first..last, or for the given steps; replies go through the
+    inbox's validation."""
+    if steps:
+        selector = f"{key}?steps={','.join(str(step) for step in steps[:MAX_STEPS_ASKED])}"
+    else:
+        selector = f"{key}?from={first}" + (f";to={last}" if last is not None else "")
     count = 0
     # No consolidation: a history replies several payloads on one key (Zenoh would keep only the last).
     for reply in session.get(selector, timeout=timeout, consolidation=zenoh.ConsolidationMode.NONE):
@@ -160,6 +187,30 @@ def fetch(
             inbox.deliver(str(reply.ok.key_expr), reply.ok.payload.to_bytes())
             count += 1
     return count
+
+
+GAP_CHECK_PERIOD = 0.5
+"""Realtime: seconds between looks for known-missing deltas (a later one of the same agent arrived)."""
+
+
+def fill_gaps(
+    session: zenoh.Session, keys: TeamKeys, replica: MapReplica, inbox: Inbox, to_the_end: Iterable[int] = ()
+) -> int:
+    """Realtime recovery: ask each sender's history for the deltas this replica knows it lacks.
+
+    A gap shows only once a later delta of the same agent arrives; the last
+    deltas of a run have none after them, so at the end ``to_the_end`` names
+    the agents whose every delta after the replica's contiguous run is asked
+    for. Replies go through the inbox like any message (validated, counted);
+    the replica applies each (agent, sequence) once, however often it comes.
+    """
+    asked = 0
+    for agent, missing in replica.gaps().items():
+        asked += fetch(session, keys.agent_history(agent), inbox, steps=missing)
+    for agent in to_the_end:
+        applied = replica.applied.get(agent)
+        asked += fetch(session, keys.agent_history(agent), inbox, first=applied.contiguous + 1 if applied else 0)
+    return asked
 
 
 @dataclass(frozen=True)

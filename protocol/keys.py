@@ -51,6 +51,10 @@ class TeamKeys:
         return f"{self.prefix}/agent/{agent}/history"
 
     @property
+    def all_histories(self) -> str:
+        return f"{self.prefix}/agent/*/history"
+
+    @property
     def go_history(self) -> str:
         return f"{self.prefix}/coordinator/history"
 

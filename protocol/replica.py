@@ -67,6 +67,10 @@ class MapReplica:
         """Known-missing sequences per agent (a later one arrived, these did not)."""
         return {agent: missing for agent, seqs in self.applied.items() if (missing := seqs.gaps())}
 
+    def contiguous(self) -> dict[str, int]:
+        """Per agent (as a JSON key), the sequence up to which every delta of it is in the map."""
+        return {str(agent): sequences.contiguous for agent, sequences in sorted(self.applied.items())}
+
     def snapshot(self, poses: dict[int, tuple[float, float, float]] | None = None) -> Snapshot:
         applied = {agent: (seqs.contiguous, tuple(sorted(seqs.extras))) for agent, seqs in self.applied.items()}
         return Snapshot(self.map.coverage.copy(), applied, dict(poses or {}))

@@ -386,29 +386,99 @@ def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_p
     assert json.loads((out / "summary.json").read_text())["completed"] is True
 
 
-def test_lost_messages_are_recovered_and_every_replica_ends_bit_identical(tmp_path):
-    """5 % of every process's incoming samples dropped on purpose (receive-side test hook): lockstep
-    notices what is missing, fetches it from the sender's history, and the run is still exact."""
+def assert_every_replica_holds_every_published_delta_once(out, agents: int) -> list[dict]:
+    """Every replica (coordinator and agents) has, from every agent, each delta it published
+    (sequences 0 … steps−1), applied once: the map is the sum of all published deltas, the same bits
+    everywhere."""
+    coordinator = json.loads((out / "coordinator_counts.json").read_text())
+    members = [json.loads((out / "logs" / f"agent-{i}.counts.json").read_text()) for i in range(agents)]
+    published = {str(i): members[i]["steps"] - 1 for i in range(agents)}
+    for counts in (coordinator, *members):
+        assert counts["applied"] == published
+        assert counts["gaps"] == 0
+    assert len({counts["map_digest"] for counts in (coordinator, *members)}) == 1
+    return [coordinator, *members]
+
+
+@pytest.mark.parametrize("clock", ["lockstep", "realtime"])
+def test_lost_messages_are_recovered_and_every_replica_ends_bit_identical(tmp_path, clock):
+    """5 % of every process's incoming samples dropped on purpose (receive-side test hook). Lockstep
+    notices what is missing when a step stalls, realtime when a later delta reveals a gap and, at the
+    end, by asking every history for what follows; both fetch it from the sender's history."""
     config = write_scenario(tmp_path / "s.toml", domain=[30.0, 30.0], agents=4, seed=2)
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
     assert engine.returncode == 0
     out = tmp_path / "team"
     launched = subprocess.run(
-        launcher_command("--config", str(config), "--out", str(out), "--no-record", "--drop-rate", "0.05"),
+        launcher_command(
+            "--config",
+            str(config),
+            "--out",
+            str(out),
+            "--no-record",
+            "--drop-rate",
+            "0.05",
+            "--clock",
+            clock,
+            "--speed",
+            "40",
+        ),
         cwd=ROOT,
         capture_output=True,
         text=True,
         timeout=400,
     )
     assert launched.returncode == 0, launched.stderr + launched.stdout
-    for name in ("trajectory.csv", "summary.json"):
-        assert (tmp_path / "engine" / name).read_bytes() == (out / name).read_bytes(), name
-    coordinator = json.loads((out / "coordinator_counts.json").read_text())
-    agents = [json.loads((out / "logs" / f"agent-{i}.counts.json").read_text()) for i in range(4)]
-    everyone = [coordinator, *agents]
+    if clock == "lockstep":
+        for name in ("trajectory.csv", "summary.json"):
+            assert (tmp_path / "engine" / name).read_bytes() == (out / name).read_bytes(), name
+    everyone = assert_every_replica_holds_every_published_delta_once(out, agents=4)
     assert all(counts["dropped"] > 0 for counts in everyone)
-    assert coordinator["recovered"] > 0 and sum(counts["recovered"] for counts in agents) > 0
-    assert len({counts["map_digest"] for counts in everyone}) == 1  # the same map everywhere, bit for bit
+    assert all(counts["recovered"] > 0 for counts in everyone)
     (out / "loss.json").write_text(
         json.dumps({"dropped": [c["dropped"] for c in everyone], "recovered": [c["recovered"] for c in everyone]})
     )
+
+
+@pytest.mark.parametrize("clock", ["lockstep", "realtime"])
+def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories(tmp_path, clock):
+    """SIGKILL the coordinator mid-run: the launcher starts a new one, which rebuilds Λ, e_D, the trace
+    and the planner's memory from the agents' histories. Lockstep still equals the engine byte for byte."""
+    team = unique_team()
+    out = tmp_path / "run"
+    extra = ["--speed", "40"] if clock == "realtime" else []
+    process = subprocess.Popen(
+        launcher_command("--n", "4", "--seed", "0", "--clock", clock, *extra, "--out", str(out), team=team),
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
+        time.sleep(2.0)  # well into the run
+        killed_at = time.time()
+        os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
+        stdout, stderr = process.communicate(timeout=400)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 0, stderr + stdout
+    assert "coordinator     killed and restarted 1 time(s)" in stdout
+    counts = json.loads((out / "coordinator_counts.json").read_text())
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] is True
+    assert 0 < counts["resumed_at"] < summary["steps"]  # it really died mid-run
+    assert_every_replica_holds_every_published_delta_once(out, agents=4)
+    if clock == "lockstep":
+        engine = anicov("run", "--n", "4", "--seed", "0", "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+        assert engine.returncode == 0
+        for name in ("trajectory.csv", "summary.json"):
+            assert (tmp_path / "engine" / name).read_bytes() == (out / name).read_bytes(), name
+    resumed = [
+        line
+        for line in (out / "logs" / "coordinator.restart-1.log").read_text().splitlines()
+        if "resumed at step" in line
+    ]
+    (out / "coordinator_restart_seconds.txt").write_text(f"{log_time(resumed[0]) - killed_at:.3f}\n")
+    assert wait_for(lambda: processes_of(team) == [], timeout=10)

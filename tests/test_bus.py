@@ -1,0 +1,133 @@
+"""protocol.bus against a real Zenoh router on loopback: histories, gap filling, the inbox's checks."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import zenoh
+
+from agents.process import END_ONLY
+from protocol.bus import History, Inbox, LossTimer, Received, fetch, fill_gaps, zenoh_config
+from protocol.keys import TeamKeys
+from protocol.messages import Limits, MapDelta, RunControl, encode
+from protocol.replica import MapReplica
+from tests.teamrun import free_port, unique_team, wait_for
+
+LIMITS = Limits(rows=20, cols=20, agents=3)
+
+
+def delta(agent: int, seq: int) -> MapDelta:
+    return MapDelta(agent, seq, seq % 10, agent, np.full((2, 2), seq + 1, dtype=np.int64))
+
+
+@pytest.fixture(scope="module")
+def sessions():
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    router = zenoh.open(zenoh_config("router", listen=[endpoint]))
+    server = zenoh.open(zenoh_config(connect=[endpoint]))
+    asker = zenoh.open(zenoh_config(connect=[endpoint]))
+    yield server, asker
+    for session in (asker, server, router):
+        session.close()
+
+
+@pytest.fixture
+def team_history(sessions):
+    """Agent 1 of a fresh team has published steps 0..49; its history serves them."""
+    server, asker = sessions
+    keys = TeamKeys(unique_team())
+    history = History(keys.agent_history(1))
+    for seq in range(50):
+        history.add(seq, encode(delta(1, seq)))
+    queryable = server.declare_queryable(keys.agent_history(1), history.serve)
+    # The declaration reaches the router asynchronously: wait until it answers.
+    assert wait_for(lambda: fetch(asker, keys.agent_history(1), Inbox(LIMITS), steps=[0]) == 1, timeout=5.0)
+    yield keys, history, asker
+    queryable.undeclare()
+
+
+def drain(inbox: Inbox) -> list[Received]:
+    items = []
+    while (item := inbox.get(timeout=0)) is not None:
+        items.append(item)
+    return items
+
+
+def test_a_history_answers_ranges_single_steps_and_wildcard_queries_on_its_own_key(team_history):
+    keys, _, asker = team_history
+    inbox = Inbox(LIMITS)
+    assert fetch(asker, keys.agent_history(1), inbox, first=10, last=12) == 3
+    assert fetch(asker, keys.agent_history(1), inbox, steps=[3, 40, 40, 77]) == 2  # 77 was never published
+    assert fetch(asker, keys.all_histories, inbox, first=48) == 2  # asked with a wildcard
+    items = drain(inbox)
+    assert [item.message.seq for item in items] == [10, 11, 12, 3, 40, 48, 49]
+    assert {item.key for item in items} == {keys.agent_history(1)}  # so the sender check applies
+    assert inbox.counts()["recovered"] == 7 and inbox.counts()["rejected"] == 0
+
+
+def test_a_malformed_history_selector_gets_no_reply(team_history):
+    keys, _, asker = team_history
+    replies = list(asker.get(f"{keys.agent_history(1)}?from=abc", timeout=1.0))
+    assert [reply for reply in replies if reply.ok is not None] == []
+
+
+def test_the_end_of_the_run_comes_with_every_history_reply(team_history):
+    """What a realtime agent that lost the end of the run asks for: no step, only the end."""
+    keys, history, asker = team_history
+    inbox = Inbox(LIMITS)
+    assert fetch(asker, keys.agent_history(1), inbox, first=END_ONLY) == 0
+    history.final = [encode(RunControl("done", 50, True, 0.0))]
+    assert fetch(asker, keys.agent_history(1), inbox, first=END_ONLY) == 1
+    assert [item.message.kind for item in drain(inbox)] == ["done"]
+
+
+def test_fill_gaps_fetches_known_missing_deltas_and_at_the_end_the_last_ones(team_history):
+    keys, _, asker = team_history
+    replica = MapReplica(20, 20, 1.0, 1.0)
+    for seq in [*range(0, 20), *range(25, 30)]:  # 20..24 lost; 30..49 lost with nothing after them
+        replica.apply(delta(1, seq))
+    assert replica.gaps() == {1: [20, 21, 22, 23, 24]}
+    inbox = Inbox(LIMITS)
+    assert fill_gaps(asker, keys, replica, inbox) == 5
+    for item in drain(inbox):
+        replica.apply(item.message)
+    assert replica.gaps() == {} and replica.contiguous() == {"1": 29}
+    fill_gaps(asker, keys, replica, inbox, to_the_end=[1, 2])  # agent 2 has no history: nothing, no error
+    for item in drain(inbox):
+        replica.apply(item.message)
+    assert replica.contiguous() == {"1": 49}
+    expected = MapReplica(20, 20, 1.0, 1.0)
+    for seq in range(50):
+        expected.apply(delta(1, seq))
+    assert replica.digest() == expected.digest()  # every delta once: the sum of all published
+
+
+def test_the_inbox_rejects_a_message_published_on_another_agents_key():
+    inbox = Inbox(LIMITS)
+    inbox.deliver("anicov/t/agent/2/delta", encode(delta(1, 0)))
+    assert drain(inbox) == []
+    assert inbox.counts()["rejected.wrong-sender"] == 1
+
+
+def test_the_drop_hook_drops_about_the_configured_fraction_and_counts_it():
+    inbox = Inbox(LIMITS, drop_rate=0.25, seed=7)
+
+    class FakeSample:  # the hook is the inbox's own logic; what delivered the sample does not matter
+        key_expr = "anicov/t/agent/1/delta"
+
+        class payload:  # mirrors zenoh.Sample.payload
+            @staticmethod
+            def to_bytes() -> bytes:
+                return encode(delta(1, 0))
+
+    for _ in range(4000):
+        inbox.on_sample(FakeSample)  # type: ignore[arg-type]
+    assert 800 < inbox.counts()["dropped"] < 1200
+    assert inbox.counts()["dropped"] + inbox.counts()["accepted"] == 4000
+
+
+def test_loss_patience_never_falls_under_its_floor_and_follows_slow_steps():
+    timer = LossTimer(floor=0.05, factor=5.0)
+    assert timer.patience == 0.05
+    timer.typical = 0.1
+    assert timer.patience == pytest.approx(0.5)
