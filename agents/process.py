@@ -227,6 +227,10 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
 
         history = History(keys.agent_history(options.agent))
         session.declare_queryable(keys.agent_history(options.agent), history.serve)
+        session.declare_queryable(
+            keys.agent_snapshot(options.agent),
+            lambda query: query.reply(keys.agent_snapshot(options.agent), encode(node.replica.snapshot())),
+        )
         loss = LossTimer()
 
         def publish(delta: MapDelta, state: AgentState) -> None:

@@ -36,8 +36,19 @@ from protocol.bus import (
     team_publisher,
     write_counts,
 )
-from protocol.keys import TeamKeys
-from protocol.messages import AgentState, Limits, MapDelta, Objectives, RunControl, StepGo, encode
+from protocol.keys import TeamKeys, agent_of_key
+from protocol.messages import (
+    AgentState,
+    Limits,
+    MapDelta,
+    Objectives,
+    ProtocolError,
+    RunControl,
+    Snapshot,
+    StepGo,
+    decode,
+    encode,
+)
 from protocol.replica import MapReplica
 
 log = logging.getLogger("anicov.coordinator")
@@ -214,7 +225,9 @@ class Coordinator:
             self.replica.has(agent, step) and self.latest_state_step.get(agent, -2) >= step for agent in self.members
         )
 
-    def rebuild(self, messages: list[MapDelta | AgentState], members: set[int]) -> int:
+    def rebuild(
+        self, messages: list[MapDelta | AgentState], members: set[int], snapshot: Snapshot | None = None
+    ) -> int:
         """A restarted coordinator: replay the agents' histories as the lost coordinator lived them.
 
         Step by step from 0, the deltas of step s−1 enter the replica (Λ_s), e_D
@@ -224,6 +237,8 @@ class Coordinator:
         Returns the step to resume at: the latest step every member has
         published. In lockstep that step is still open (its deltas go into the
         next go), so a run that lost its coordinator still equals the engine.
+        Agents gone before the restart left no history: their coverage is
+        adopted from a member's ``snapshot``.
         """
         deltas: dict[int, list[MapDelta]] = {}
         states: dict[int, list[AgentState]] = {}
@@ -236,6 +251,8 @@ class Coordinator:
         for step, of_step in states.items():
             for state in of_step:
                 latest[state.agent] = max(latest.get(state.agent, -1), step)
+        if not latest:
+            raise RuntimeError(f"the team is running but no history of agents {sorted(members)} could be read")
         resume = min(latest.values())
         snapshot_steps = max(1, round(SNAPSHOT_PERIOD / self.scenario.dt))
         lockstep = self.open_step is not None
@@ -256,6 +273,10 @@ class Coordinator:
                 for state in states.get(step, []):
                     self.latest_state_step[state.agent] = step
                     self.positions[state.agent] = (state.next_pose[0], state.next_pose[1])
+            gone = set(snapshot.applied) - members if snapshot is not None else set()
+            if gone and snapshot is not None:
+                self.replica.adopt(snapshot, [m for m in messages if isinstance(m, MapDelta)], gone)
+                self.log.events.append(f"coverage of agents {sorted(gone)} taken from a member's snapshot")
             if lockstep:
                 self.open_step = resume
             # What lies beyond: the open step's deltas (for the next go) and any later ones.
@@ -351,6 +372,10 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                 break
         step = 0
         if running:
+            # Robots that died before this coordinator started left no history, but their coverage is in
+            # every live replica: take one, first (anything in it is then also in the histories below).
+            members = alive_agents(session, keys, scenario.agents)
+            snapshot = member_snapshot(session, keys, node.limits, members)
             # Ends when every history has replied in full; live messages keep coming meanwhile,
             # so take only what is queued then: the rest is for the main loop.
             fetch(session, keys.all_histories, node.inbox, first=0, timeout=HISTORY_TIMEOUT)
@@ -362,7 +387,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                     running.append(item.message)  # type: ignore[union-attr]
                 else:
                     node.handle(item)
-            step = node.rebuild(running, node.alive & set(range(scenario.agents)))
+            step = node.rebuild(running, members, snapshot)
             node.log.events.append(f"coordinator resumed at step {step}")
             log.warning(
                 "a running team: resumed at step %d from the histories of agents %s", step, sorted(node.members)
@@ -494,6 +519,33 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
     if outcome is None:
         return stop.exit_code(EXIT_FAILED)
     return EXIT_OK if outcome[1] else EXIT_INCOMPLETE
+
+
+def alive_agents(session: zenoh.Session, keys: TeamKeys, agents: int) -> set[int]:
+    """The agents whose liveliness token is declared now (asked, not waited for)."""
+    alive = set()
+    for reply in session.liveliness().get(keys.alive_agents, timeout=2.0):
+        if reply.ok is not None:
+            agent = agent_of_key(str(reply.ok.key_expr))
+            if agent is not None and 0 <= agent < agents:
+                alive.add(agent)
+    return alive
+
+
+def member_snapshot(session: zenoh.Session, keys: TeamKeys, limits: Limits, members: set[int]) -> Snapshot | None:
+    """The replica of the first member that answers, or None."""
+    for agent in sorted(members):
+        for reply in session.get(keys.agent_snapshot(agent), timeout=2.0):
+            if reply.ok is None:
+                continue
+            try:
+                snapshot = decode(reply.ok.payload.to_bytes(), limits, expected="snapshot")
+            except ProtocolError as error:
+                log.warning("agent %d's snapshot rejected: %s", agent, error)
+                continue
+            assert isinstance(snapshot, Snapshot)
+            return snapshot
+    return None
 
 
 def is_running(item: Received | Membership) -> bool:

@@ -4,6 +4,7 @@ key (under anicov/<team>/)  message              from → to           what
 agent/<id>/delta            MapDelta             agent → all         coverage it added in one step
 agent/<id>/state            AgentState           agent → all         pose, (v, ω), e_Ω of one step
 agent/<id>/history          (queryable)          agent               its recent deltas and states
+agent/<id>/snapshot         (queryable)          agent               its replica: for a restarted coordinator
 coordinator/go              StepGo               coordinator → all   lockstep: step k may start, with
                                                                      every step k−1 delta, targets on replans
 coordinator/objectives      Objectives           coordinator → all   realtime: the latest targets
@@ -46,6 +47,9 @@ class TeamKeys:
 
     def agent_state(self, agent: int) -> str:
         return f"{self.prefix}/agent/{agent}/state"
+
+    def agent_snapshot(self, agent: int) -> str:
+        return f"{self.prefix}/agent/{agent}/snapshot"
 
     def agent_history(self, agent: int) -> str:
         return f"{self.prefix}/agent/{agent}/history"

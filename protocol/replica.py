@@ -10,6 +10,7 @@ process can load it and keep applying deltas without double counting.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,6 +46,8 @@ class MapReplica:
         self.map = CoverageMap(rows, cols, cell, coverage_target)
         self.applied: dict[int, AppliedSequences] = {}
         self.duplicates = 0
+        # A snapshot may be served from Zenoh's thread while the main thread applies deltas.
+        self._lock = threading.Lock()
 
     def has(self, agent: int, seq: int) -> bool:
         """Whether (agent, seq) is in the map; every agent trivially has 'step −1' (nothing)."""
@@ -55,13 +58,14 @@ class MapReplica:
 
     def apply(self, delta: MapDelta) -> bool:
         """Add a delta unless this (agent, seq) was applied before; True if it was new."""
-        sequences = self.applied.setdefault(delta.agent, AppliedSequences())
-        if sequences.contains(delta.seq):
-            self.duplicates += 1
-            return False
-        self.map.add(delta.row0, delta.col0, delta.ticks)
-        sequences.add(delta.seq)
-        return True
+        with self._lock:
+            sequences = self.applied.setdefault(delta.agent, AppliedSequences())
+            if sequences.contains(delta.seq):
+                self.duplicates += 1
+                return False
+            self.map.add(delta.row0, delta.col0, delta.ticks)
+            sequences.add(delta.seq)
+            return True
 
     def gaps(self) -> dict[int, list[int]]:
         """Known-missing sequences per agent (a later one arrived, these did not)."""
@@ -72,8 +76,9 @@ class MapReplica:
         return {str(agent): sequences.contiguous for agent, sequences in sorted(self.applied.items())}
 
     def snapshot(self, poses: dict[int, tuple[float, float, float]] | None = None) -> Snapshot:
-        applied = {agent: (seqs.contiguous, tuple(sorted(seqs.extras))) for agent, seqs in self.applied.items()}
-        return Snapshot(self.map.coverage.copy(), applied, dict(poses or {}))
+        with self._lock:
+            applied = {agent: (seqs.contiguous, tuple(sorted(seqs.extras))) for agent, seqs in self.applied.items()}
+            return Snapshot(self.map.coverage.copy(), applied, dict(poses or {}))
 
     def digest(self) -> str:
         """A short hash of the map, to compare replicas across processes."""
@@ -86,7 +91,39 @@ class MapReplica:
         if snapshot.coverage.shape != self.map.coverage.shape:
             raise ValueError("snapshot grid differs from this replica's")
         target = self.map.target_ticks
-        self.map.coverage[...] = snapshot.coverage
-        self.map.uncovered_cells = int((snapshot.coverage < target).sum())
-        self.map.deficit_ticks = int(np.maximum(target - snapshot.coverage, 0).sum())
-        self.applied = {agent: AppliedSequences(seq, set(extras)) for agent, (seq, extras) in snapshot.applied.items()}
+        with self._lock:
+            self.map.coverage[...] = snapshot.coverage
+            self.map.uncovered_cells = int((snapshot.coverage < target).sum())
+            self.map.deficit_ticks = int(np.maximum(target - snapshot.coverage, 0).sum())
+            self.applied = {
+                agent: AppliedSequences(seq, set(extras)) for agent, (seq, extras) in snapshot.applied.items()
+            }
+
+    def adopt(self, snapshot: Snapshot, known: list[MapDelta], agents: set[int]) -> None:
+        """Take ``agents``' coverage from another replica's snapshot, exactly.
+
+        ``known`` must hold every delta in the snapshot from any other agent:
+        the cells are plain sums, so the snapshot minus those is what ``agents``
+        contributed. A restarted coordinator uses it for robots that died
+        before it started: their histories are gone, their coverage is not.
+        """
+        others = np.zeros_like(snapshot.coverage)
+        counted: set[tuple[int, int]] = set()
+        for delta in known:
+            contiguous, extras = snapshot.applied.get(delta.agent, (-1, ()))
+            if (delta.agent, delta.seq) in counted or delta.agent in agents:
+                continue
+            counted.add((delta.agent, delta.seq))
+            if delta.seq <= contiguous or delta.seq in extras:
+                others[
+                    delta.row0 : delta.row0 + delta.ticks.shape[0], delta.col0 : delta.col0 + delta.ticks.shape[1]
+                ] += delta.ticks
+        theirs = snapshot.coverage - others
+        if (theirs < 0).any():
+            raise ValueError("the known deltas are not all in the snapshot: cannot tell whose coverage is whose")
+        with self._lock:
+            for agent in agents:
+                if agent in snapshot.applied and agent not in self.applied:
+                    seq, extras = snapshot.applied[agent]
+                    self.applied[agent] = AppliedSequences(seq, set(extras))
+            self.map.add(0, 0, theirs)

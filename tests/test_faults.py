@@ -193,7 +193,13 @@ def malformed_payloads(total: int, seed: int = 7) -> list[bytes]:
 
 
 def test_fuzzed_payloads_on_every_key_are_rejected_and_the_run_is_untouched(tmp_path):
-    config = write_scenario(tmp_path / "s.toml", domain=[30.0, 30.0], agents=2, seed=9)
+    fuzz_a_running_team(tmp_path, domain=[30.0, 30.0], at_least=10_500, at_most=70_000)
+
+
+def fuzz_a_running_team(tmp_path, domain: list[float], at_least: int, at_most: int) -> None:
+    """Publish malformed payloads on every key a 2-agent team listens to, round-robin, from the
+    agents' start until the run ends (at least ``at_least``, at most ``at_most``)."""
+    config = write_scenario(tmp_path / "s.toml", domain=domain, agents=2, seed=9)
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
     assert engine.returncode == 0
     payloads = malformed_payloads(4000)
@@ -223,7 +229,7 @@ def test_fuzzed_payloads_on_every_key_are_rejected_and_the_run_is_untouched(tmp_
             publishers = [
                 session.declare_publisher(key, congestion_control=zenoh.CongestionControl.BLOCK) for key in targets
             ]
-            while sent < 10_500 or (process.poll() is None and sent < 70_000):
+            while sent < at_least or (process.poll() is None and sent < at_most):
                 for publisher in publishers:
                     publisher.put(payloads[sent % len(payloads)])
                     sent += 1
@@ -233,7 +239,7 @@ def test_fuzzed_payloads_on_every_key_are_rejected_and_the_run_is_untouched(tmp_
     finally:
         if process.poll() is None:
             process.kill()
-    assert sent >= 10_000
+    assert sent >= at_least
     assert process.returncode == 0, stderr + stdout
     # The map, the trajectories, everything equals the run without the noise.
     for name in ("trajectory.csv", "summary.json"):
@@ -440,10 +446,15 @@ def test_lost_messages_are_recovered_and_every_replica_ends_bit_identical(tmp_pa
     )
 
 
-@pytest.mark.parametrize("clock", ["lockstep", "realtime"])
-def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories(tmp_path, clock):
+@pytest.mark.parametrize(
+    ("clock", "agent_dies_first"),
+    [("lockstep", False), ("realtime", False), ("lockstep", True)],
+    ids=["lockstep", "realtime", "lockstep-after-an-agent-died"],
+)
+def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories(tmp_path, clock, agent_dies_first):
     """SIGKILL the coordinator mid-run: the launcher starts a new one, which rebuilds Λ, e_D, the trace
-    and the planner's memory from the agents' histories. Lockstep still equals the engine byte for byte."""
+    and the planner's memory from the agents' histories. Lockstep still equals the engine byte for byte.
+    An agent killed before the coordinator left no history: its coverage comes from a member's replica."""
     team = unique_team()
     out = tmp_path / "run"
     extra = ["--speed", "40"] if clock == "realtime" else []
@@ -457,6 +468,9 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     try:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)  # well into the run
+        if agent_dies_first:
+            os.kill(agent_pid(team, 2), signal.SIGKILL)
+            time.sleep(1.0)
         killed_at = time.time()
         os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
         stdout, stderr = process.communicate(timeout=400)
@@ -465,6 +479,13 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
             process.kill()
     assert process.returncode == 0, stderr + stdout
     assert "coordinator     killed and restarted 1 time(s)" in stdout
+    if agent_dies_first:
+        coordinator = json.loads((out / "coordinator_counts.json").read_text())
+        survivors = [json.loads((out / "logs" / f"agent-{i}.counts.json").read_text()) for i in (0, 1, 3)]
+        assert "coverage of agents [2] taken from a member's snapshot" in coordinator["events"]
+        assert len({c["map_digest"] for c in (coordinator, *survivors)}) == 1  # agent 2's coverage kept everywhere
+        assert json.loads((out / "summary.json").read_text())["completed"] is True
+        return
     counts = json.loads((out / "coordinator_counts.json").read_text())
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is True
