@@ -43,6 +43,7 @@ from protocol.bus import (
     Received,
     fetch,
     fill_gaps,
+    open_session,
     team_publisher,
     write_counts,
 )
@@ -211,7 +212,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
     node = AgentNode(scenario, options)
     parent = os.getppid()
     keys = node.keys
-    with zenoh.open(config) as session:
+    with open_session(config) as session:
         lockstep = options.clock == "lockstep"
         if lockstep:
             # Teammates' deltas arrive bundled in the coordinator's go: one message a step, not N − 1.

@@ -11,11 +11,9 @@ import time
 import uuid
 from pathlib import Path
 
+from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, EXIT_USAGE
 from anicov.scenario import CONTROLLERS, Scenario, ScenarioError, load_scenario
 
-EXIT_OK = 0
-EXIT_INCOMPLETE = 1
-EXIT_USAGE = 2
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "scenarios" / "paper.toml"
 
 
@@ -290,6 +288,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ScenarioError, ValueError) as error:
         print(f"anicov: error: {error}", file=sys.stderr)
         return EXIT_USAGE
+    except RuntimeError as error:  # e.g. protocol.bus.RouterUnreachable: say what, not a traceback
+        print(f"anicov: error: {error}", file=sys.stderr)
+        return EXIT_FAILED
     except KeyboardInterrupt:
         print("anicov: interrupted", file=sys.stderr)
         return 130

@@ -20,7 +20,7 @@ import zenoh
 from anicov.lifecycle import EXIT_OK, StopFlag, parent_is_gone
 from anicov.recording import RunRecorder
 from anicov.scenario import Scenario
-from protocol.bus import Inbox, Membership, Received, write_counts
+from protocol.bus import Inbox, Membership, Received, open_session, write_counts
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
@@ -146,7 +146,7 @@ def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config,
     node = TeamLogger(scenario, options)
     keys = TeamKeys(options.team)
     parent = os.getppid()
-    with zenoh.open(config) as session:
+    with open_session(config) as session:
         # Lockstep bundles every step's deltas (and the objectives) in the coordinator's go.
         traffic = (keys.go,) if options.clock == "lockstep" else (keys.all_deltas, keys.objectives)
         for key in (*traffic, keys.all_states, keys.control):

@@ -33,6 +33,7 @@ from protocol.bus import (
     Received,
     fetch,
     fill_gaps,
+    open_session,
     team_publisher,
     write_counts,
 )
@@ -329,7 +330,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
     parent = os.getppid()
     lockstep = options.clock == "lockstep"
     outcome: tuple[int, bool, int] | None = None
-    with zenoh.open(config) as session:
+    with open_session(config) as session:
         session.declare_subscriber(keys.all_deltas, node.inbox.on_sample)
         session.declare_subscriber(keys.all_states, node.inbox.on_sample)
         session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)

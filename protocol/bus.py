@@ -52,17 +52,21 @@ def zenoh_config(
     return config
 
 
-def open_session(config: zenoh.Config, attempts: int = 40, delay: float = 0.25) -> zenoh.Session:
+class RouterUnreachable(RuntimeError):
+    """No session could be opened within the patience given (the router is down, or refuses us)."""
+
+
+def open_session(config: zenoh.Config, patience: float = 30.0, delay: float = 0.25) -> zenoh.Session:
     """Open a session, retrying while the router is not up yet (a robot may boot before it)."""
-    for attempt in range(attempts):
+    deadline = time.monotonic() + patience
+    while True:
         try:
             return zenoh.open(config)
         except zenoh.ZError as error:
-            if attempt == attempts - 1:
-                raise
+            if time.monotonic() >= deadline:
+                raise RouterUnreachable(f"no Zenoh session after {patience:.0f} s of retries: {error}") from error
             log.debug("zenoh open failed (%s), retrying", error)
             time.sleep(delay)
-    raise RuntimeError("unreachable")
 
 
 def team_publisher(session: zenoh.Session, key: str) -> zenoh.Publisher:
