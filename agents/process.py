@@ -2,21 +2,19 @@
 
 It keeps its own replica of the coverage map, decides (v, ω) with the same
 functions as the in-process engine (:mod:`agents.step`), commands its robot,
-and publishes its coverage delta and its state every step. It applies its
-teammates' deltas and follows the coordinator's objectives.
+and publishes its step (coverage delta and state, one message) every step.
+It applies its teammates' deltas and follows the coordinator's objectives.
 
 Clocks:
 
-- ``lockstep``: step k starts when every member's step k−1 delta is in the
-  replica and, on a replanning step, the coordinator's go for step k (with
-  the new objectives) has arrived; teammates' deltas of step k or later are
-  held back until this agent has done step k. Between replanning steps the
-  agents pace each other directly, so the coordinator is off the critical
-  path. Every replica then holds exactly the engine's Λ_k at step k, every
-  agent sees full coverage at the same step, and the run equals the
-  in-process engine bit for bit.
+- ``lockstep``: step k starts when the coordinator's go for step k arrives.
+  The go carries every member's step k−1 delta (and, on a replanning step,
+  the new objectives), so the replica then holds exactly the engine's Λ_k:
+  every agent sees full coverage at the same step, and the run equals the
+  in-process engine bit for bit. One message in and one out per agent-step.
 - ``realtime``: one step every dt/speed seconds of wall-clock time, with
-  whatever has arrived by then; never waits for anyone.
+  whatever has arrived by then; never waits for anyone. Lost deltas are
+  fetched from the sender's history (gaps, and at the end of the run).
 """
 
 from __future__ import annotations
@@ -50,6 +48,7 @@ from protocol.bus import (
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
+    AgentStep,
     Limits,
     MapDelta,
     Objectives,
@@ -106,9 +105,9 @@ class AgentNode:
         if isinstance(item, Membership):
             return
         message = item.message
-        if isinstance(message, MapDelta):  # realtime: teammates' deltas, applied as they come
+        if isinstance(message, AgentStep):  # realtime: teammates' deltas, applied as they come
             if message.agent != self.options.agent:
-                self.replica.apply(message)
+                self.replica.apply(message.delta)
         elif isinstance(message, StepGo):
             if message.step >= self.step:
                 self.gos[message.step] = message
@@ -219,11 +218,10 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             session.declare_subscriber(keys.go, node.inbox.on_sample)
         else:
             # Remote only: our own deltas are applied when made, an echo would only cost a decode.
-            session.declare_subscriber(keys.all_deltas, node.inbox.on_sample, allowed_origin=zenoh.Locality.REMOTE)
+            session.declare_subscriber(keys.all_steps, node.inbox.on_sample, allowed_origin=zenoh.Locality.REMOTE)
             session.declare_subscriber(keys.objectives, node.inbox.on_sample)
         session.declare_subscriber(keys.control, node.inbox.on_sample)
-        delta_publisher = team_publisher(session, keys.agent_delta(options.agent))
-        state_publisher = team_publisher(session, keys.agent_state(options.agent))
+        step_publisher = team_publisher(session, keys.agent_step(options.agent))
         token = session.liveliness().declare_token(keys.alive("agent", options.agent))
 
         history = History(keys.agent_history(options.agent))
@@ -235,11 +233,10 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         loss = LossTimer()
 
         def publish(delta: MapDelta, state: AgentState) -> None:
-            delta_bytes, state_bytes = encode(delta), encode(state)
-            node.bytes_sent += len(delta_bytes) + len(state_bytes)
-            history.add(state.step, delta_bytes, state_bytes)
-            delta_publisher.put(delta_bytes)
-            state_publisher.put(state_bytes)
+            payload = encode(AgentStep(delta, state))  # one message a step: one send, one delivery each
+            node.bytes_sent += len(payload)
+            history.add(state.step, payload)
+            step_publisher.put(payload)
 
         def recover_go() -> None:
             """A go (or the end of the run) that should be here is not: ask the coordinator's history."""
@@ -258,7 +255,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         hellos = 0
         while not node.started and node.finished is None and not stop.stopped:
             if time.monotonic() >= next_hello:
-                state_publisher.put(encode(node.hello()))
+                step_publisher.put(encode(node.hello()))
                 next_hello = time.monotonic() + HELLO_PERIOD
                 hellos += 1
                 if hellos % 5 == 0:

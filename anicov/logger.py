@@ -24,8 +24,8 @@ from protocol.bus import Inbox, Membership, Received, open_session, write_counts
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
+    AgentStep,
     Limits,
-    MapDelta,
     Objectives,
     ProtocolError,
     RunControl,
@@ -82,22 +82,16 @@ class TeamLogger:
             )
             return
         message = item.message
-        if isinstance(message, MapDelta):
-            self.replica.apply(message)
-        elif isinstance(message, AgentState):
-            if message.step >= 0:
-                self.recorder.state(
-                    message.agent, message.step, *message.pose, message.v, message.omega, message.e_omega
-                )
-            self.positions[message.agent] = message.next_pose[:2]
-            if message.step + 1 > self.latest_step:
-                self.latest_step = message.step + 1
-                self.recorder.domain_error(self.latest_step, self.replica.map.domain_error())
-                if self.latest_step % self.recorder.map_every == 0:
-                    self.recorder.lack_map(self.latest_step, self.replica.map.lack_of_coverage())
-        elif isinstance(message, StepGo):
+        if isinstance(message, AgentStep):  # realtime
+            self.replica.apply(message.delta)
+            self.take_state(message.state)
+        elif isinstance(message, AgentState):  # a hello
+            self.take_state(message)
+        elif isinstance(message, StepGo):  # lockstep: the whole previous step in one message
             for delta in message.deltas:
                 self.replica.apply(delta)
+            for state in message.states:
+                self.take_state(state)
             if message.objectives is not None:
                 objectives = message.objectives
                 self.recorder.objectives(
@@ -114,6 +108,17 @@ class TeamLogger:
             )
         elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
             self.finished = message
+
+    def take_state(self, state: AgentState) -> None:
+        """A state of step k; once the first of step k arrives (after its deltas), e_D and the map of k+1."""
+        if state.step >= 0:
+            self.recorder.state(state.agent, state.step, *state.pose, state.v, state.omega, state.e_omega)
+        self.positions[state.agent] = state.next_pose[:2]
+        if state.step + 1 > self.latest_step:
+            self.latest_step = state.step + 1
+            self.recorder.domain_error(self.latest_step, self.replica.map.domain_error())
+            if self.latest_step % self.recorder.map_every == 0:
+                self.recorder.lack_map(self.latest_step, self.replica.map.lack_of_coverage())
 
     def load_snapshot(self, session: zenoh.Session, keys: TeamKeys) -> None:
         """A late logger starts from the coordinator's map."""
@@ -147,9 +152,10 @@ def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config,
     keys = TeamKeys(options.team)
     parent = os.getppid()
     with open_session(config) as session:
-        # Lockstep bundles every step's deltas (and the objectives) in the coordinator's go.
-        traffic = (keys.go,) if options.clock == "lockstep" else (keys.all_deltas, keys.objectives)
-        for key in (*traffic, keys.all_states, keys.control):
+        # Lockstep bundles every step's deltas, states and objectives in the coordinator's go:
+        # one message a step, whatever the team size.
+        traffic = (keys.go,) if options.clock == "lockstep" else (keys.all_steps, keys.objectives)
+        for key in (*traffic, keys.control):
             session.declare_subscriber(key, node.inbox.on_sample)
         session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
         token = session.liveliness().declare_token(keys.alive("logger"))

@@ -40,6 +40,7 @@ from protocol.bus import (
 from protocol.keys import TeamKeys, agent_of_key
 from protocol.messages import (
     AgentState,
+    AgentStep,
     Limits,
     MapDelta,
     Objectives,
@@ -117,6 +118,8 @@ class Coordinator:
         self.open_step: int | None = 0 if options.clock == "lockstep" else None
         self.held_back: list[MapDelta] = []
         self.open_deltas: dict[int, MapDelta] = {}
+        self.states_by_step: dict[int, dict[int, AgentState]] = {}  # lockstep: states not yet sent in a go
+        self.closed_states: dict[int, AgentState] = self.states_by_step.get(-1, {})  # the hellos, for go 0
         self.lock = threading.Lock()  # the snapshot queryable reads the replica from Zenoh's thread
 
     def snapshot_payload(self) -> bytes:
@@ -148,16 +151,27 @@ class Coordinator:
                     log.warning("agent %d left the team", item.agent)
             return
         message = item.message
-        if isinstance(message, MapDelta):
-            if self.open_step is not None and message.seq > self.open_step:
-                self.held_back.append(message)  # lockstep: Λ must not run ahead of the step being closed
-            else:
-                self.offer(message)
-        elif isinstance(message, AgentState):
-            self.log.record(message)
-            if message.step >= self.latest_state_step.get(message.agent, -2):
-                self.latest_state_step[message.agent] = message.step
-                self.positions[message.agent] = (message.next_pose[0], message.next_pose[1])
+        if isinstance(message, AgentStep):
+            self._take_delta(message.delta)
+            self._take_state(message.state)
+        elif isinstance(message, MapDelta):
+            self._take_delta(message)
+        elif isinstance(message, AgentState):  # a hello (step −1), or a state from a history
+            self._take_state(message)
+
+    def _take_delta(self, delta: MapDelta) -> None:
+        if self.open_step is not None and delta.seq > self.open_step:
+            self.held_back.append(delta)  # lockstep: Λ must not run ahead of the step being closed
+        else:
+            self.offer(delta)
+
+    def _take_state(self, state: AgentState) -> None:
+        self.log.record(state)
+        if self.open_step is not None and state.step >= self.open_step - 1:
+            self.states_by_step.setdefault(state.step, {})[state.agent] = state  # for the go of step + 1
+        if state.step >= self.latest_state_step.get(state.agent, -2):
+            self.latest_state_step[state.agent] = state.step
+            self.positions[state.agent] = (state.next_pose[0], state.next_pose[1])
 
     def open_next_step(self) -> list[MapDelta]:
         """Lockstep: after the open step was closed (Λ_{k+1} measured), let step k+1's deltas in.
@@ -169,6 +183,7 @@ class Coordinator:
     def _open_next_step(self) -> list[MapDelta]:
         assert self.open_step is not None
         closed = list(self.open_deltas.values())
+        self.closed_states = self.states_by_step.pop(self.open_step, {})
         self.open_deltas = {}
         self.open_step += 1
         waiting = [delta for delta in self.held_back if delta.seq > self.open_step]
@@ -189,10 +204,13 @@ class Coordinator:
             return self.plan(step)
         return None
 
-    def go(self, step: int, deltas: list[MapDelta]) -> StepGo:
-        """Lockstep: step ``step`` may start, with every member's previous delta."""
-        kept = tuple(delta for delta in deltas if delta.agent in self.members)
-        return StepGo(step, tuple(sorted(self.members)), kept, self.plan_if_due(step) if self.members else None)
+    def go(self, step: int, deltas: list[MapDelta], final: bool = False) -> StepGo:
+        """Lockstep: step ``step`` may start, with every member's previous delta and state (the closed
+        step's). The final go only completes every replica: no objectives."""
+        kept = tuple(sorted((delta for delta in deltas if delta.agent in self.members), key=lambda d: d.agent))
+        states = tuple(self.closed_states[agent] for agent in sorted(self.closed_states) if agent in self.members)
+        objectives = self.plan_if_due(step) if self.members and not final else None
+        return StepGo(step, tuple(sorted(self.members)), kept, objectives, states)
 
     def plan(self, step: int) -> Objectives:
         members = sorted(self.members)
@@ -284,7 +302,7 @@ class Coordinator:
             for message in messages:
                 if isinstance(message, MapDelta) and message.seq >= resume and message.agent in members:
                     self._handle(Received("", message))
-                elif isinstance(message, AgentState) and message.step > resume and message.agent in members:
+                elif isinstance(message, AgentState) and message.step >= resume and message.agent in members:
                     self._handle(Received("", message))
         return resume
 
@@ -331,8 +349,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
     lockstep = options.clock == "lockstep"
     outcome: tuple[int, bool, int] | None = None
     with open_session(config) as session:
-        session.declare_subscriber(keys.all_deltas, node.inbox.on_sample)
-        session.declare_subscriber(keys.all_states, node.inbox.on_sample)
+        session.declare_subscriber(keys.all_steps, node.inbox.on_sample)
         session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
         session.declare_queryable(keys.snapshot, lambda query: query.reply(keys.snapshot, node.snapshot_payload()))
         objectives_publisher = team_publisher(session, keys.objectives)
@@ -366,7 +383,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             item = node.inbox.get(timeout=0.1)
             if item is not None:
                 if is_running(item):
-                    running.append(item.message)  # type: ignore[union-attr]
+                    running += [item.message.delta, item.message.state]  # type: ignore[union-attr]
                 else:
                     node.handle(item)
             if parent_is_gone(parent) or time.monotonic() > deadline:
@@ -385,7 +402,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                 if item is None:
                     break
                 if is_running(item):
-                    running.append(item.message)  # type: ignore[union-attr]
+                    running += [item.message.delta, item.message.state]  # type: ignore[union-attr]
                 else:
                     node.handle(item)
             step = node.rebuild(running, members, snapshot)
@@ -410,6 +427,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         next_plan = time.monotonic()
         next_gap_check = next_plan + GAP_CHECK_PERIOD
         if lockstep and not running:
+            node.closed_states = node.states_by_step.pop(-1, {})  # the hellos: where everyone starts
             publish_go(node.go(0, []))
         elif not lockstep:
             publish(objectives_publisher, encode(node.plan(0)))
@@ -440,8 +458,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                     if node.replica.map.complete or step >= scenario.max_steps or not node.members:
                         outcome = (step, node.replica.map.complete, step)
                         # The last go only completes every replica; the agents then wait for the end.
-                        last = tuple(node.open_next_step())
-                        publish_go(StepGo(step, tuple(sorted(node.members)), last))
+                        publish_go(node.go(step, node.open_next_step(), final=True))
                         break
                     publish_go(node.go(step, node.open_next_step()))
             else:
@@ -550,10 +567,8 @@ def member_snapshot(session: zenoh.Session, keys: TeamKeys, limits: Limits, memb
 
 
 def is_running(item: Received | Membership) -> bool:
-    """A delta, or a state of a step already taken: the team is past its hellos."""
-    if not isinstance(item, Received):
-        return False
-    return isinstance(item.message, MapDelta) or (isinstance(item.message, AgentState) and item.message.step >= 0)
+    """A step already taken: the team is past its hellos."""
+    return isinstance(item, Received) and isinstance(item.message, AgentStep)
 
 
 def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, object]) -> None:

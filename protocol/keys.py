@@ -1,12 +1,12 @@
 """Zenoh key expressions of a team. Everything lives under ``anicov/<team>/``.
 
 key (under anicov/<team>/)  message              from → to           what
-agent/<id>/delta            MapDelta             agent → all         coverage it added in one step
-agent/<id>/state            AgentState           agent → all         pose, (v, ω), e_Ω of one step
-agent/<id>/history          (queryable)          agent               its recent deltas and states
+agent/<id>/step             AgentStep            agent → all         one step: coverage added, pose, (v, ω), e_Ω
+                            AgentState           agent → all         hello (step −1): its pose at t_0
+agent/<id>/history          (queryable)          agent               its recent steps
 agent/<id>/snapshot         (queryable)          agent               its replica: for a restarted coordinator
-coordinator/go              StepGo               coordinator → all   lockstep: step k may start, with
-                                                                     every step k−1 delta, targets on replans
+coordinator/go              StepGo               coordinator → all   lockstep: step k may start, with every
+                                                                     step k−1 delta and state, targets on replans
 coordinator/objectives      Objectives           coordinator → all   realtime: the latest targets
 coordinator/snapshot        (queryable)          coordinator         map, sequences, poses: late joiners
 coordinator/history         (queryable)          coordinator         recent gos and the end of the run
@@ -42,11 +42,8 @@ class TeamKeys:
     def prefix(self) -> str:
         return f"{ROOT}/{self.team}"
 
-    def agent_delta(self, agent: int) -> str:
-        return f"{self.prefix}/agent/{agent}/delta"
-
-    def agent_state(self, agent: int) -> str:
-        return f"{self.prefix}/agent/{agent}/state"
+    def agent_step(self, agent: int) -> str:
+        return f"{self.prefix}/agent/{agent}/step"
 
     def agent_snapshot(self, agent: int) -> str:
         return f"{self.prefix}/agent/{agent}/snapshot"
@@ -63,12 +60,8 @@ class TeamKeys:
         return f"{self.prefix}/coordinator/history"
 
     @property
-    def all_deltas(self) -> str:
-        return f"{self.prefix}/agent/*/delta"
-
-    @property
-    def all_states(self) -> str:
-        return f"{self.prefix}/agent/*/state"
+    def all_steps(self) -> str:
+        return f"{self.prefix}/agent/*/step"
 
     @property
     def objectives(self) -> str:

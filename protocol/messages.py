@@ -8,7 +8,9 @@ range, map windows inside the grid, non-negative deltas) and raises
 decode may touch a map or a controller.
 
     MapDelta    agent, seq (= step), window (row0, col0, ticks int64 h×w)   eq. 3
-    AgentState  agent, step, pose at t_k, v, ω, e_Ω, pose at t_k+1
+    AgentState  agent, step, pose at t_k, v, ω, e_Ω, pose at t_k+1 (step −1: hello)
+    AgentStep   what an agent publishes each step: its MapDelta and its AgentState
+    StepGo      lockstep: step k may start; every member's step k−1 delta and state
     Objectives  step k, members, targets (one per member), blob objectives  Alg. 1–2
     RunControl  kind (done | abort | status), step, completed, e_D, reason
     Snapshot    the coverage map and the applied sequences per agent
@@ -104,16 +106,30 @@ class Snapshot:
 
 
 @dataclass(frozen=True)
+class AgentStep:
+    """One agent's step k: the coverage it added and its state, in one message (one send, one delivery)."""
+
+    delta: MapDelta
+    state: AgentState
+
+    @property
+    def agent(self) -> int:
+        return self.state.agent
+
+
+@dataclass(frozen=True)
 class StepGo:
-    """Lockstep: step k may start. Carries every member's step k−1 delta, and on a replan the objectives."""
+    """Lockstep: step k may start. Carries every member's step k−1 delta and state (so a listener needs
+    no other message), and on a replan the objectives."""
 
     step: int
     members: tuple[int, ...]
     deltas: tuple[MapDelta, ...]
     objectives: Objectives | None = None
+    states: tuple[AgentState, ...] = ()
 
 
-Message = MapDelta | AgentState | Objectives | RunControl | Snapshot | StepGo
+Message = MapDelta | AgentState | AgentStep | Objectives | RunControl | Snapshot | StepGo
 
 
 # ---------------------------------------------------------------- encoding
@@ -133,6 +149,17 @@ def _delta_body(message: MapDelta) -> dict[str, Any]:
         "h": ticks.shape[0],
         "w": ticks.shape[1],
         "ticks": ticks.tobytes(),
+    }
+
+
+def _state_body(message: AgentState) -> dict[str, Any]:
+    return {
+        "agent": message.agent,
+        "step": message.step,
+        "pose": list(message.pose),
+        "vel": [message.v, message.omega],
+        "e_omega": message.e_omega,
+        "next": list(message.next_pose),
     }
 
 
@@ -158,21 +185,14 @@ def encode(message: Message) -> bytes:
                 "step": message.step,
                 "members": list(message.members),
                 "deltas": [_delta_body(delta) for delta in message.deltas],
+                "states": [_state_body(state) for state in message.states],
                 "objectives": None if message.objectives is None else _objectives_body(message.objectives),
             },
         )
+    if isinstance(message, AgentStep):
+        return _pack("step", {"delta": _delta_body(message.delta), "state": _state_body(message.state)})
     if isinstance(message, AgentState):
-        return _pack(
-            "state",
-            {
-                "agent": message.agent,
-                "step": message.step,
-                "pose": list(message.pose),
-                "vel": [message.v, message.omega],
-                "e_omega": message.e_omega,
-                "next": list(message.next_pose),
-            },
-        )
+        return _pack("state", _state_body(message))
     if isinstance(message, Objectives):
         return _pack("objectives", _objectives_body(message))
     if isinstance(message, RunControl):
@@ -288,6 +308,38 @@ def _decode_delta(body: dict[str, Any], limits: Limits) -> MapDelta:
     return MapDelta(agent, seq, row0, col0, ticks)
 
 
+def _decode_state(body: dict[str, Any], limits: Limits) -> AgentState:
+    pose = _floats(body, "pose", 3)
+    vel = _floats(body, "vel", 2)
+    nxt = _floats(body, "next", 3)
+    e_omega = _finite(body.get("e_omega"), "e_omega")
+    if not 0.0 <= e_omega <= 1.0:
+        raise ProtocolError("out-of-range", "e_omega not in [0, 1]")
+    return AgentState(
+        _int(body, "agent", 0, limits.agents - 1),
+        _int(body, "step", -1, MAX_STEP),
+        (pose[0], pose[1], pose[2]),
+        vel[0],
+        vel[1],
+        e_omega,
+        (nxt[0], nxt[1], nxt[2]),
+    )
+
+
+def _submap(body: dict[str, Any], key: str) -> dict[str, Any]:
+    value = body.get(key)
+    if not isinstance(value, dict):
+        raise ProtocolError("bad-field", f"{key} must be a map")
+    return value
+
+
+def _submaps(body: dict[str, Any], key: str, most: int) -> list[dict[str, Any]]:
+    value = body.get(key, [])
+    if not isinstance(value, list) or len(value) > most or not all(isinstance(item, dict) for item in value):
+        raise ProtocolError("bad-field", f"{key} must be a list of maps, at most one per agent")
+    return value
+
+
 def _decode_objectives(body: dict[str, Any], limits: Limits) -> Objectives:
     last_agent = limits.agents - 1
     step = _int(body, "step", 0, MAX_STEP)
@@ -315,44 +367,29 @@ def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Messa
     if kind == "delta":
         return _decode_delta(body, limits)
     if kind == "state":
-        pose = _floats(body, "pose", 3)
-        vel = _floats(body, "vel", 2)
-        nxt = _floats(body, "next", 3)
-        e_omega = _finite(body.get("e_omega"), "e_omega")
-        if not 0.0 <= e_omega <= 1.0:
-            raise ProtocolError("out-of-range", "e_omega not in [0, 1]")
-        return AgentState(
-            _int(body, "agent", 0, last_agent),
-            _int(body, "step", -1, MAX_STEP),
-            (pose[0], pose[1], pose[2]),
-            vel[0],
-            vel[1],
-            e_omega,
-            (nxt[0], nxt[1], nxt[2]),
-        )
+        return _decode_state(body, limits)
+    if kind == "step":
+        delta = _decode_delta(_submap(body, "delta"), limits)
+        state = _decode_state(_submap(body, "state"), limits)
+        if delta.agent != state.agent or delta.seq != state.step:
+            raise ProtocolError("out-of-range", "a step's delta and state must be of one agent and one step")
+        return AgentStep(delta, state)
     if kind == "objectives":
         return _decode_objectives(body, limits)
     if kind == "go":
         step = _int(body, "step", 0, MAX_STEP)
         members = _members(body, last_agent)
-        raw_deltas = body.get("deltas")
-        if not isinstance(raw_deltas, list) or len(raw_deltas) > limits.agents:
-            raise ProtocolError("bad-field", "deltas must be a list, at most one per agent")
-        deltas = []
-        for item in raw_deltas:
-            if not isinstance(item, dict):
-                raise ProtocolError("bad-field", "each delta must be a map")
-            delta = _decode_delta(item, limits)
-            if delta.seq != step - 1:
-                raise ProtocolError("out-of-range", "a go for step k carries deltas of step k-1 only")
-            deltas.append(delta)
-        if len({delta.agent for delta in deltas}) != len(deltas):
-            raise ProtocolError("out-of-range", "one delta per agent")
+        deltas = [_decode_delta(item, limits) for item in _submaps(body, "deltas", limits.agents)]
+        states = [_decode_state(item, limits) for item in _submaps(body, "states", limits.agents)]
+        if any(delta.seq != step - 1 for delta in deltas) or any(state.step != step - 1 for state in states):
+            raise ProtocolError("out-of-range", "a go for step k carries deltas and states of step k-1 only")
+        if len({delta.agent for delta in deltas}) != len(deltas) or len({s.agent for s in states}) != len(states):
+            raise ProtocolError("out-of-range", "one delta and one state per agent")
         raw_objectives = body.get("objectives")
         if raw_objectives is not None and not isinstance(raw_objectives, dict):
             raise ProtocolError("bad-field", "objectives must be a map or nil")
         objectives = None if raw_objectives is None else _decode_objectives(raw_objectives, limits)
-        return StepGo(step, tuple(members), tuple(deltas), objectives)
+        return StepGo(step, tuple(members), tuple(deltas), objectives, tuple(states))
     if kind == "control":
         control_kind = body.get("kind")
         if control_kind not in RUN_CONTROL_KINDS:

@@ -23,6 +23,7 @@ from protocol.bus import zenoh_config
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
+    AgentStep,
     Limits,
     MapDelta,
     Objectives,
@@ -101,8 +102,13 @@ LIMITS = Limits(rows=30, cols=30, agents=2)
 
 def valid_payloads() -> list[bytes]:
     return [
-        encode(MapDelta(0, 5, 3, 4, np.ones((2, 3), dtype=np.int64))),
-        encode(AgentState(1, 7, (1.0, 2.0, 0.3), 0.5, 0.1, 0.4, (1.1, 2.0, 0.31))),
+        encode(
+            AgentStep(
+                MapDelta(1, 7, 3, 4, np.ones((2, 3), dtype=np.int64)),
+                AgentState(1, 7, (1.0, 2.0, 0.3), 0.5, 0.1, 0.4, (1.1, 2.0, 0.31)),
+            )
+        ),
+        encode(AgentState(1, -1, (1.0, 2.0, 0.3), 0.0, 0.0, 0.0, (1.0, 2.0, 0.3))),
         encode(Objectives(50, (0, 1), np.array([[1.0, 2.0], [3.0, 4.0]]), np.array([[5.0, 6.0]]))),
         encode(RunControl("done", 10, True, 0.0)),
     ]
@@ -205,10 +211,8 @@ def fuzz_a_running_team(tmp_path, domain: list[float], at_least: int, at_most: i
     payloads = malformed_payloads(4000)
     keys = TeamKeys(unique_team())
     targets = [
-        keys.agent_delta(0),
-        keys.agent_delta(1),
-        keys.agent_state(0),
-        keys.agent_state(1),
+        keys.agent_step(0),
+        keys.agent_step(1),
         keys.objectives,
         keys.go,
         keys.control,
@@ -249,8 +253,8 @@ def fuzz_a_running_team(tmp_path, domain: list[float], at_least: int, at_most: i
     logger_counts = json.loads((out / "logs" / "logger.counts.json").read_text())
     # Every payload reached every subscriber of its key and was rejected there: none lost, none accepted.
     per_key = sent // len(targets)
-    assert logger_counts["rejected"] == 4 * per_key  # lockstep logger: go, two states, control
-    assert counts["rejected"] == 4 * per_key  # coordinator: two deltas, two states
+    assert logger_counts["rejected"] == 2 * per_key  # lockstep logger: go, control
+    assert counts["rejected"] == 2 * per_key  # coordinator: the two agents' steps
     assert all(c["rejected"] == 2 * per_key for c in agent_counts)  # lockstep agents: go, control
     reasons = {key for c in [counts, logger_counts, *agent_counts] for key in c if key.startswith("rejected.")}
     assert {"rejected.undecodable", "rejected.bad-version"} <= reasons

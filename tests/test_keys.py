@@ -5,10 +5,12 @@ from protocol.keys import TeamKeys, agent_of_key, check_team_name
 
 def test_keys_live_under_the_team_prefix():
     keys = TeamKeys("alpha")
-    assert keys.agent_delta(3) == "anicov/alpha/agent/3/delta"
-    assert keys.all_deltas == "anicov/alpha/agent/*/delta"
+    assert keys.agent_step(3) == "anicov/alpha/agent/3/step"
+    assert keys.all_steps == "anicov/alpha/agent/*/step"
+    assert keys.all_histories == "anicov/alpha/agent/*/history"
     assert keys.alive("agent", 2) == "anicov/alpha/alive/agent/2"
-    assert agent_of_key(keys.agent_state(12)) == 12
+    assert agent_of_key(keys.agent_step(12)) == 12
+    assert agent_of_key(keys.agent_snapshot(5)) == 5
     assert agent_of_key(keys.alive("agent", 7)) == 7
     assert agent_of_key(keys.objectives) is None
 

@@ -9,12 +9,14 @@ from hypothesis import strategies as st
 from protocol.messages import (
     PROTOCOL_VERSION,
     AgentState,
+    AgentStep,
     Limits,
     MapDelta,
     Objectives,
     ProtocolError,
     RunControl,
     Snapshot,
+    StepGo,
     decode,
     encode,
 )
@@ -49,6 +51,28 @@ def test_state_objectives_control_snapshot_round_trip():
     snapshot = decode(encode(Snapshot(coverage, {0: (5, (7, 9)), 3: (-1, ())})), LIMITS)
     assert np.array_equal(snapshot.coverage, coverage)
     assert snapshot.applied == {0: (5, (7, 9)), 3: (-1, ())}
+
+
+def test_a_step_and_a_go_carry_deltas_and_states_whole():
+    ticks = np.full((2, 3), 7, dtype=np.int64)
+    state = AgentState(2, 9, (1.0, 2.0, 0.5), 0.25, -0.5, 0.75, (1.1, 2.1, 0.55))
+    step = decode(encode(AgentStep(MapDelta(2, 9, 4, 5, ticks), state)), LIMITS)
+    assert isinstance(step, AgentStep) and step.agent == 2 and step.state == state
+    assert np.array_equal(step.delta.ticks, ticks) and (step.delta.row0, step.delta.col0) == (4, 5)
+    go = decode(encode(StepGo(10, (0, 2), (step.delta,), None, (state,))), LIMITS)
+    assert isinstance(go, StepGo) and go.states == (state,) and go.deltas[0].agent == 2
+
+
+def test_a_step_whose_delta_and_state_disagree_is_rejected():
+    state = AgentState(2, 9, (1.0, 2.0, 0.5), 0.25, -0.5, 0.75, (1.1, 2.1, 0.55))
+    other_agent = encode(AgentStep(MapDelta(1, 9, 4, 5, np.ones((1, 1), np.int64)), state))
+    other_step = encode(AgentStep(MapDelta(2, 8, 4, 5, np.ones((1, 1), np.int64)), state))
+    assert reason_of(other_agent) == reason_of(other_step) == "out-of-range"
+    stale = encode(StepGo(10, (2,), (), None, (state,)))  # a state of step 9 belongs to the go of step 10 ...
+    assert decode(stale, LIMITS).states == (state,)
+    assert reason_of(encode(StepGo(11, (2,), (), None, (state,)))) == "out-of-range"  # ... not of step 11
+    twice = encode(StepGo(10, (2,), (), None, (state, state)))
+    assert reason_of(twice) == "out-of-range"
 
 
 def body(**fields):
@@ -92,6 +116,8 @@ def good_delta(**changes):
         (body(type="state", agent=0, step=1, pose=[0, 0, 0], vel=[0, 0], e_omega=1.5, next=[0, 0, 0]), "out-of-range"),
         (body(type="objectives", step=1, members=[0, 0], targets=[0, 0, 0, 0], blobs=[]), "out-of-range"),
         (body(type="objectives", step=1, members=[0], targets=[0], blobs=[]), "bad-shape"),
+        (body(type="step", delta=[1, 2], state={}), "bad-field"),
+        (body(type="go", step=3, members=[0], deltas=[], states=[1]), "bad-field"),
         (body(type="control", kind="explode", step=1, completed=False, e_d=0.0, reason=""), "bad-field"),
         (body(type="snapshot", rows=100, cols=100, map=b"not zlib", applied=[]), "undecodable"),
         (body(type="snapshot", rows=50, cols=100, map=b"", applied=[]), "out-of-range"),

@@ -99,18 +99,18 @@ def test_an_agent_cannot_publish_as_another_agent_or_as_the_coordinator(profile,
     ):
         coordinator.declare_subscriber(f"anicov/{TEAM}/**", lambda sample: received.append(str(sample.key_expr)))
         time.sleep(0.5)  # the subscription reaches the router
-        for key in ("agent/0/delta", "agent/0/state", "coordinator/go", "coordinator/objectives", "run/control"):
+        for key in ("agent/0/step", "agent/0/history", "coordinator/go", "coordinator/objectives", "run/control"):
             agent.put(f"anicov/{TEAM}/{key}", b"spoofed")
         agent.liveliness().declare_token(f"anicov/{TEAM}/alive/agent/0")
-        agent.put(f"anicov/{TEAM}/agent/1/delta", b"own")  # after the spoofs, on the same link
+        agent.put(f"anicov/{TEAM}/agent/1/step", b"own")  # after the spoofs, on the same link
         deadline = time.monotonic() + 5.0
-        while f"anicov/{TEAM}/agent/1/delta" not in received and time.monotonic() < deadline:
+        while f"anicov/{TEAM}/agent/1/step" not in received and time.monotonic() < deadline:
             time.sleep(0.05)
         time.sleep(0.3)
         tokens = [
             str(reply.ok.key_expr) for reply in coordinator.liveliness().get(f"anicov/{TEAM}/alive/**") if reply.ok
         ]
-    assert received == [f"anicov/{TEAM}/agent/1/delta"]
+    assert received == [f"anicov/{TEAM}/agent/1/step"]
     assert f"anicov/{TEAM}/alive/agent/0" not in tokens
 
 
