@@ -392,8 +392,8 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         if running:
             # Robots that died before this coordinator started left no history, but their coverage is in
             # every live replica: take one, first (anything in it is then also in the histories below).
-            members = alive_agents(session, keys, scenario.agents)
-            snapshot = member_snapshot(session, keys, node.limits, members)
+            # Any live agent's replica will do (dead ones do not answer).
+            snapshot = member_snapshot(session, keys, node.limits, set(range(scenario.agents)))
             # Ends when every history has replied in full; live messages keep coming meanwhile,
             # so take only what is queued then: the rest is for the main loop.
             fetch(session, keys.all_histories, node.inbox, first=0, timeout=HISTORY_TIMEOUT)
@@ -405,6 +405,10 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                     running += [item.message.delta, item.message.state]  # type: ignore[union-attr]
                 else:
                     node.handle(item)
+            # Members: whoever holds a liveliness token now, and whoever answered from its history
+            # (only a live process answers; a token may not have reached this new session yet).
+            members = alive_agents(session, keys, scenario.agents) | node.alive
+            members |= {message.agent for message in running if isinstance(message, AgentState)}
             step = node.rebuild(running, members, snapshot)
             node.log.events.append(f"coordinator resumed at step {step}")
             log.warning(
