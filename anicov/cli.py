@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import shutil
 import subprocess
@@ -97,6 +98,8 @@ def command_logger(args: argparse.Namespace) -> int:
         args.map_every,
         args.counts,
         args.clock,
+        args.web_port,
+        args.grpc_port,
     )
     config = zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
     return run_logger(scenario, options, config, stop)
@@ -140,9 +143,15 @@ def command_coordinator(args: argparse.Namespace) -> int:
     setup_logging("coordinator", args.verbose)
     stop = StopFlag().install()
     scenario = _process_scenario(args)
-    options = CoordinatorOptions(args.team, args.clock, args.speed, args.out, args.drop_rate)
+    options = CoordinatorOptions(args.team, args.clock, args.speed, args.out, args.drop_rate, args.await_logger)
     config = zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
-    return run_coordinator(scenario, options, config, stop)
+    code = run_coordinator(scenario, options, config, stop)
+    # Its session is closed and its files are written: skip the interpreter's teardown of numba,
+    # matplotlib and friends (half a second), which the whole team's launcher would wait for.
+    logging.shutdown()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
 
 
 def command_router(args: argparse.Namespace) -> int:
@@ -227,6 +236,8 @@ def build_parser() -> argparse.ArgumentParser:
     logger.add_argument("--no-record", action="store_true", help="no file (only a live viewer)")
     logger.add_argument("--viewer", action="store_true", help="spawn a live rerun viewer")
     logger.add_argument("--serve", action="store_true", help="serve a web viewer for a remote browser")
+    logger.add_argument("--web-port", type=int, default=9090, help="--serve: HTTP port of the web viewer")
+    logger.add_argument("--grpc-port", type=int, default=9876, help="--serve: port of the recording's gRPC server")
     logger.add_argument("--map-every", type=int, default=50, help="log the map every K steps (default 50)")
     logger.add_argument("--counts", help="write message counters to this JSON file at exit")
     logger.add_argument(
@@ -251,6 +262,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     coordinator = commands.add_parser("coordinator", help="the team's coordinator (Algorithms 1-2), on the bus")
     coordinator.add_argument("--out", help="write the run directory here at the end")
+    coordinator.add_argument(
+        "--await-logger", action="store_true", help="start the run only once a logger is listening"
+    )
     _add_process_arguments(coordinator)
     coordinator.set_defaults(handler=command_coordinator)
 

@@ -83,6 +83,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--drop-rate", type=float, default=0.0, help=argparse.SUPPRESS)  # test hook: loss
     parser.add_argument("--viewer", action="store_true", help="spawn a live rerun viewer")
     parser.add_argument("--serve", action="store_true", help="serve a web viewer (for a browser on another machine)")
+    parser.add_argument("--web-port", type=int, default=9090, help="--serve: HTTP port of the web viewer")
+    parser.add_argument("--grpc-port", type=int, default=9876, help="--serve: port of the recording's gRPC server")
     parser.add_argument("--map-every", type=int, default=50, help="log the map every K steps (default 50)")
     return parser
 
@@ -155,17 +157,6 @@ def wait_for_exit(children: list[Child], timeout: float) -> None:
             child.process.wait(timeout=max(0.0, deadline - time.monotonic()))
         except subprocess.TimeoutExpired:
             pass
-
-
-def wait_for_token(session, key: str, timeout: float) -> bool:
-    """Wait until a liveliness token is declared (a child is up and subscribed)."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if any(reply.ok is not None for reply in session.liveliness().get(key, timeout=0.5)):
-            return True
-        time.sleep(0.1)
-    log.warning("%s did not appear in %.0f s", key, timeout)
-    return False
 
 
 def warm_numba_cache() -> None:
@@ -247,9 +238,14 @@ def main(argv: list[str] | None = None) -> int:
     with router:
         router.declare_subscriber(keys.control, on_control)
         router.declare_subscriber(keys.status, on_control)
-        coordinator_command = child_command("coordinator", args, ["--out", str(out_dir)])
+        recording = not args.no_record or args.viewer or args.serve
+        # All children start at once; the coordinator starts the run when every agent has said hello
+        # and, when recording, the logger listens (so the recording holds every step).
+        coordinator_command = child_command(
+            "coordinator", args, ["--out", str(out_dir)] + ["--await-logger"] * bool(recording)
+        )
         children.append(spawn("coordinator", coordinator_command, logs))
-        if not args.no_record or args.viewer or args.serve:
+        if recording:
             logger_flags = [
                 "--out",
                 str(out_dir / "recording.rrd"),
@@ -259,10 +255,10 @@ def main(argv: list[str] | None = None) -> int:
                 f"{args.team}-{out_dir.name}",
             ]
             logger_flags += ["--counts", str(logs / "logger.counts.json")]
-            logger_flags += ["--no-record"] * args.no_record + ["--viewer"] * args.viewer + ["--serve"] * args.serve
+            logger_flags += ["--no-record"] * args.no_record + ["--viewer"] * args.viewer
+            if args.serve:
+                logger_flags += ["--serve", "--web-port", str(args.web_port), "--grpc-port", str(args.grpc_port)]
             children.append(spawn("logger", child_command("logger", args, logger_flags), logs))
-            # The logger subscribes before the agents start, so it sees the run from step 0.
-            wait_for_token(router, keys.alive("logger"), timeout=60.0)
         for agent in range(scenario.agents):
             agent_flags = ["--id", str(agent), "--counts", str(logs / f"agent-{agent}.counts.json")]
             name = f"agent-{agent}"

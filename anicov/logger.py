@@ -51,6 +51,8 @@ class LoggerOptions:
     map_every: int = 50
     counts_file: str | None = None
     clock: str = "lockstep"
+    web_port: int = 9090
+    grpc_port: int = 9876
 
 
 class TeamLogger:
@@ -67,6 +69,8 @@ class TeamLogger:
             options.spawn_viewer,
             options.serve_web,
             options.map_every,
+            options.web_port,
+            options.grpc_port,
         )
         self.positions = np.full((scenario.agents, 2), np.nan)
         self.latest_step = -1

@@ -26,6 +26,7 @@ simulated time unit).
 from __future__ import annotations
 
 import math
+import socket
 from collections import deque
 from pathlib import Path
 
@@ -70,6 +71,8 @@ class RunRecorder:
         spawn_viewer: bool = False,
         serve_web: bool = False,
         map_every: int = 50,
+        web_port: int = 9090,
+        grpc_port: int = 9876,
     ) -> None:
         self.scenario = scenario
         self.rows, self.cols = scenario.grid_shape
@@ -79,15 +82,19 @@ class RunRecorder:
         if path is not None:
             path.parent.mkdir(parents=True, exist_ok=True)
             sinks.append(rr.FileSink(str(path)))
-        if serve_web:
-            uri = self.stream.serve_grpc()
-            rr.serve_web_viewer(connect_to=uri, open_browser=False)
-            print(f"rerun web viewer: http://localhost:9090/?url={uri}", flush=True)
+        server = rr.GrpcServerSink(port=grpc_port) if serve_web else None
+        if server is not None:
+            sinks.append(server)  # a sink beside the file: set_sinks replaces, so all go in one call
         if spawn_viewer:
             self.stream.spawn(connect=False)
             sinks.append(rr.GrpcSink())
         if sinks:
             self.stream.set_sinks(*sinks)
+        if server is not None:
+            # The browser connects to the gRPC server itself: name this host, not the 0.0.0.0 it binds.
+            uri = server.uri.replace("0.0.0.0", socket.gethostname())
+            rr.serve_web_viewer(web_port=web_port, connect_to=uri, open_browser=False)
+            print(f"rerun web viewer: http://{socket.gethostname()}:{web_port}/?url={uri}", flush=True)
         self.stream.send_blueprint(default_blueprint(scenario.agents))
         self._trails: list[deque[tuple[float, float]]] = [
             deque(maxlen=TRAIL_STEPS // self.map_every + 1) for _ in range(scenario.agents)

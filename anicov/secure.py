@@ -113,7 +113,7 @@ def _rule(ident: str, messages: list[str], flows: list[str], key_exprs: list[str
 def zenoh_profile_config(role: str, directory: Path, endpoint: str, team: str, agents: int) -> dict[str, object]:
     """The Zenoh config of one role: the router listens, everyone else connects, all over mutual TLS."""
     tls: dict[str, object] = {"root_ca_certificate": str(directory / "ca.pem"), "enable_mtls": True}
-    config: dict[str, object] = {"scouting": {"multicast": {"enabled": False}}}
+    config: dict[str, object] = {"scouting": {"multicast": {"enabled": False}, "delay": 0}}
     if role == "router":
         tls |= {
             "listen_private_key": str(directory / "router.key"),

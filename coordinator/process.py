@@ -70,6 +70,7 @@ class CoordinatorOptions:
     speed: float = 1.0
     out: str | None = None
     drop_rate: float = 0.0
+    await_logger: bool = False  # start only once a logger listens (so its recording has every step)
 
 
 @dataclass
@@ -376,7 +377,10 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         running: list[MapDelta | AgentState] = []
         deadline = time.monotonic() + START_TIMEOUT
         next_look = 0.0
-        while len(node.positions) < scenario.agents and not running and not stop.stopped:
+        logger_ready = not options.await_logger
+        while (len(node.positions) < scenario.agents or not logger_ready) and not running and not stop.stopped:
+            if not logger_ready:
+                logger_ready = any(r.ok is not None for r in session.liveliness().get(keys.alive("logger"), timeout=0.5))
             if time.monotonic() >= next_look:  # lockstep agents that lost their coordinator wait in silence
                 fetch(session, keys.all_histories, node.inbox, first=0, last=0, timeout=0.5)
                 next_look = time.monotonic() + 0.5
@@ -414,8 +418,13 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             log.warning(
                 "a running team: resumed at step %d from the histories of agents %s", step, sorted(node.members)
             )
-        elif len(node.positions) < scenario.agents:
-            log.error("only %d of %d agents said hello; giving up", len(node.positions), scenario.agents)
+        elif len(node.positions) < scenario.agents or not logger_ready:
+            log.error(
+                "only %d of %d agents said hello%s; giving up",
+                len(node.positions),
+                scenario.agents,
+                "" if logger_ready else " and no logger appeared",
+            )
             publish(control_publisher, encode(RunControl("abort", 0, reason="agents missing at start")))
             token.undeclare()
             return stop.exit_code(EXIT_FAILED)
@@ -516,8 +525,10 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                 encode(RunControl("abort", step, False, node.replica.map.domain_error(), reason="coordinator stopped")),
             )
         # Deltas still in flight (realtime agents step until they hear the end) join the map.
+        # (Lockstep: nothing is in flight, the last go closed every step.)
         node.open_step = None
-        node.drain(0.5)
+        if not lockstep:
+            node.drain(0.5)
         if outcome is not None:
             publish(control_publisher, done)  # again, for whoever lost the first (it is idempotent)
         if not lockstep:  # and those lost on the way, last ones included (see fill_gaps)

@@ -102,3 +102,58 @@ def test_replay_summary_prints_what_the_recording_holds(tmp_path):
 def test_replay_of_a_missing_file_is_a_clear_error(tmp_path):
     done = anicov("replay", "--summary", str(tmp_path / "none.rrd"))
     assert done.returncode == 2 and "no recording at" in done.stderr
+
+
+def test_serve_hosts_a_web_viewer_and_a_grpc_server_while_the_file_is_still_written(tmp_path):
+    """--serve (for a browser on another machine) and the recording file at once: rerun's set_sinks
+    replaces sinks, so both must be given together; the file must not lose anything to the server."""
+    import socket
+    import urllib.request
+
+    from tests.teamrun import ROOT, free_port, wait_for
+
+    web_port, grpc_port = free_port(), free_port()
+    out = tmp_path / "run"
+    process = subprocess.Popen(
+        launcher_command(
+            "--n",
+            "4",
+            "--seed",
+            "0",
+            "--out",
+            str(out),
+            "--serve",
+            "--web-port",
+            str(web_port),
+            "--grpc-port",
+            str(grpc_port),
+        ),
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+    def page() -> bytes:
+        try:
+            with urllib.request.urlopen(f"http://127.0.0.1:{web_port}/", timeout=2) as response:
+                return response.read() if response.status == 200 else b""
+        except OSError:
+            return b""
+
+    try:
+        assert wait_for(lambda: page() != b"", timeout=120)
+        assert b"<html" in page().lower()
+        with socket.create_connection(("127.0.0.1", grpc_port), timeout=2):
+            pass  # the recording's gRPC server accepts viewers
+        stdout, stderr = process.communicate(timeout=400)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 0, stderr + stdout
+    announced = (out / "logs" / "logger.log").read_text()
+    assert f":{web_port}/?url=rerun+http://" in announced and f":{grpc_port}/proxy" in announced
+    assert "0.0.0.0" not in announced
+    summary = summarise_recording(out / "recording.rrd")
+    assert summary.final_domain_error == 0.0
+    assert expected_entities(4) <= set(summary.entities)
