@@ -30,7 +30,7 @@ import zenoh
 from agents.parameters import initial_poses, law_parameters
 from agents.robot import Robot, SimulatedUnicycle
 from agents.step import LawParameters, decide_and_sense
-from anicov.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone
+from anicov.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
 from anicov.scenario import Scenario
 from protocol.bus import (
     GAP_CHECK_PERIOD,
@@ -223,6 +223,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         session.declare_subscriber(keys.control, node.inbox.on_sample)
         step_publisher = team_publisher(session, keys.agent_step(options.agent))
         token = session.liveliness().declare_token(keys.alive("agent", options.agent))
+        settle_garbage_collector()
 
         history = History(keys.agent_history(options.agent))
         session.declare_queryable(keys.agent_history(options.agent), history.serve)

@@ -34,6 +34,8 @@ log = logging.getLogger("anicov.launch")
 
 GRACE_SECONDS = 10.0
 """How long children get to exit after SIGTERM before SIGKILL."""
+LOGGER_NICE = 10
+"""The logger's CPU priority below the team's: it is off the critical path and catches up when cores idle."""
 COORDINATOR_RESTARTS = 3
 """How many times a coordinator killed by a signal is started again (it resumes from the agents)."""
 
@@ -254,7 +256,7 @@ def main(argv: list[str] | None = None) -> int:
                 "--recording-id",
                 f"{args.team}-{out_dir.name}",
             ]
-            logger_flags += ["--counts", str(logs / "logger.counts.json")]
+            logger_flags += ["--counts", str(logs / "logger.counts.json"), "--nice", str(LOGGER_NICE)]
             logger_flags += ["--no-record"] * args.no_record + ["--viewer"] * args.viewer
             if args.serve:
                 logger_flags += ["--serve", "--web-port", str(args.web_port), "--grpc-port", str(args.grpc_port)]

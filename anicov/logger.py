@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 import zenoh
 
-from anicov.lifecycle import EXIT_OK, StopFlag, parent_is_gone
+from anicov.lifecycle import EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 from anicov.recording import RunRecorder
 from anicov.scenario import Scenario
-from protocol.bus import Inbox, Membership, Received, open_session, write_counts
+from protocol.bus import Inbox, Membership, Received, fetch, open_session, write_counts
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
@@ -39,6 +39,8 @@ log = logging.getLogger("anicov.logger")
 
 FLUSH_PERIOD = 0.5
 """Seconds between sends of the buffered per-step columns."""
+READ_PERIOD = 0.25
+"""Lockstep: seconds between reads of the coordinator's history of gos (the live view lags this much)."""
 
 
 @dataclass
@@ -76,6 +78,7 @@ class TeamLogger:
         self.latest_step = -1
         self.logged_map_step = -1
         self.finished: RunControl | None = None
+        self.next_go = 0  # lockstep: the first go not read yet
 
     def handle(self, item: Received | Membership) -> None:
         if isinstance(item, Membership):
@@ -92,6 +95,9 @@ class TeamLogger:
         elif isinstance(message, AgentState):  # a hello
             self.take_state(message)
         elif isinstance(message, StepGo):  # lockstep: the whole previous step in one message
+            if message.step < self.next_go:
+                return  # read twice (a batch overlapped the previous one)
+            self.next_go = message.step + 1
             for delta in message.deltas:
                 self.replica.apply(delta)
             for state in message.states:
@@ -136,6 +142,8 @@ class TeamLogger:
                 continue
             assert isinstance(snapshot, Snapshot)
             self.replica.load(snapshot)
+            if snapshot.applied:  # a late start: the gos before the snapshot's map are already in it
+                self.next_go = max(self.next_go, min(seq for seq, _ in snapshot.applied.values()) + 2)
             log.info("loaded the coordinator's snapshot (e_D = %.4f)", self.replica.map.domain_error())
 
     def finish(self) -> None:
@@ -156,23 +164,37 @@ def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config,
     keys = TeamKeys(options.team)
     parent = os.getppid()
     with open_session(config) as session:
-        # Lockstep bundles every step's deltas, states and objectives in the coordinator's go:
-        # one message a step, whatever the team size.
-        traffic = (keys.go,) if options.clock == "lockstep" else (keys.all_steps, keys.objectives)
+        # Lockstep bundles every step's deltas, states and objectives in the coordinator's go. The
+        # logger reads them in batches from the coordinator's history rather than one sample a step:
+        # a process's cost is per message, not per byte, and this one is off the critical path.
+        lockstep = options.clock == "lockstep"
+        traffic = () if lockstep else (keys.all_steps, keys.objectives)
         for key in (*traffic, keys.control):
             session.declare_subscriber(key, node.inbox.on_sample)
         session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
         token = session.liveliness().declare_token(keys.alive("logger"))
+        settle_garbage_collector()
         node.load_snapshot(session, keys)
         next_flush = time.monotonic() + FLUSH_PERIOD
+        next_read = 0.0
+
+        def read_gos() -> None:
+            """Every go since the last read (and the end of the run, once known), in step order."""
+            fetch(session, keys.go_history, node.inbox, first=node.next_go, timeout=5.0, recovery=False)
+
         while node.finished is None and not stop.stopped and not parent_is_gone(parent):
-            item = node.inbox.get(timeout=0.1)
+            if lockstep and time.monotonic() >= next_read:
+                read_gos()
+                next_read = time.monotonic() + READ_PERIOD
+            item = node.inbox.get(timeout=READ_PERIOD / 2)
             if item is not None:
                 node.handle(item)
             if time.monotonic() >= next_flush:
                 node.recorder.flush_states()
                 next_flush = time.monotonic() + FLUSH_PERIOD
         # Drain what is already here (the last deltas travel beside the end-of-run message).
+        if lockstep and node.finished is not None:
+            read_gos()  # the gos up to the end, if the end came first on run/control
         deadline = time.monotonic() + 0.5
         while time.monotonic() < deadline and (item := node.inbox.get(timeout=0.05)) is not None:
             node.handle(item)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -59,9 +60,14 @@ def run_team(agents: int, config: str | None, record: bool = False) -> dict[str,
     }
 
 
+def median(values: list[float]) -> float:
+    return statistics.median(values)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--skip-30", action="store_true", help="only N = 4")
+    parser.add_argument("--repeats", type=int, default=3, help="runs of each N = 4 variant (default 3)")
     args = parser.parse_args()
     print(f"machine: {describe_machine()}")
     rtt = ping(2000, 256)
@@ -69,25 +75,43 @@ def main() -> None:
         f"bare Zenoh ping-pong between two processes via a router: median {rtt['median_us']:.0f} µs, "
         f"p90 {rtt['p90_us']:.0f} µs"
     )
+    # Without and with the logger, interleaved, so a slow spell of a shared machine hits both alike.
+    plain: list[dict[str, float]] = []
+    recorded: list[dict[str, float]] = []
+    for _ in range(args.repeats):
+        plain.append(run_team(4, None))
+        recorded.append(run_team(4, None, record=True))
+    print(f"\nN = 4, paper scenario, {args.repeats} runs each (median, then min – max):")
     print(
-        "| team | steps | stepping time (s) | launcher wall (s) | steps/s | round trips per step | "
-        "coordinator bytes in+out per step |"
+        "| variant | steps | stepping time (s) | launcher wall (s) | steps/s | round trips per step | bytes per step |"
     )
     print("|---|---|---|---|---|---|---|")
-    rows = {}
-    for agents in (4,) if args.skip_30 else (4, 30):
-        row = rows[agents] = run_team(agents, None)
-        per_step_us = 1e6 / row["steps_per_s"]
+    for name, runs in (("no logger", plain), ("logger recording", recorded)):
+        stepping = [run["stepping_s"] for run in runs]
+        wall = [run["wall_s"] for run in runs]
+        rate = [run["steps_per_s"] for run in runs]
+        trips = [1e6 / r / rtt["median_us"] for r in rate]
         print(
-            f"| N = {agents} (paper) | {row['steps']} | {row['stepping_s']:.1f} | {row['wall_s']:.1f} | "
-            f"{row['steps_per_s']:.0f} | {per_step_us / rtt['median_us']:.1f} | {row['bus_bytes_per_step']:,.0f} |"
+            f"| {name} | {runs[0]['steps']} | {median(stepping):.1f} ({min(stepping):.1f} – {max(stepping):.1f}) | "
+            f"{median(wall):.1f} ({min(wall):.1f} – {max(wall):.1f}) | {median(rate):.0f} | "
+            f"{median(trips):.1f} | {median([run['bus_bytes_per_step'] for run in runs]):,.0f} |"
         )
-    recorded = run_team(4, None, record=True)
+    ratios = [
+        with_logger["steps_per_s"] / without["steps_per_s"]
+        for without, with_logger in zip(plain, recorded, strict=True)
+    ]
     print(
-        f"\nwith the logger recording (N = 4): {recorded['steps_per_s']:.0f} steps/s, "
-        f"{100 * recorded['steps_per_s'] / rows[4]['steps_per_s']:.0f} % of the rate without; "
-        f"recording {recorded['recording_bytes_per_1000_steps'] / 1e6:.2f} MB per 1,000 steps"
+        f"\nwith the logger: {100 * median(ratios):.0f} % of the step rate without it (median of {args.repeats} "
+        f"interleaved pairs; {100 * min(ratios):.0f} – {100 * max(ratios):.0f} %); recording "
+        f"{median([run['recording_bytes_per_1000_steps'] for run in recorded]) / 1e6:.2f} MB per 1,000 steps"
     )
+    if not args.skip_30:
+        row = run_team(30, None)
+        print(
+            f"\nN = 30 (30 agent processes), paper scenario: {row['steps']} steps, {row['stepping_s']:.1f} s of "
+            f"stepping, {row['wall_s']:.1f} s wall, {row['steps_per_s']:.0f} steps/s, "
+            f"{row['bus_bytes_per_step']:,.0f} bytes through the coordinator per step"
+        )
 
 
 if __name__ == "__main__":

@@ -22,7 +22,7 @@ import numpy as np
 import zenoh
 
 from anicov.engine import SNAPSHOT_PERIOD, TRACE_FIELDS, Planner, RunResult
-from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone
+from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 from anicov.scenario import Scenario
 from protocol.bus import (
     GAP_CHECK_PERIOD,
@@ -367,6 +367,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         control_publisher = team_publisher(session, keys.control)
         status_publisher = team_publisher(session, keys.status)
         token = session.liveliness().declare_token(keys.alive("coordinator"))
+        settle_garbage_collector()
 
         def publish(publisher: zenoh.Publisher, payload: bytes) -> None:
             node.bytes_sent += len(payload)
@@ -380,7 +381,9 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         logger_ready = not options.await_logger
         while (len(node.positions) < scenario.agents or not logger_ready) and not running and not stop.stopped:
             if not logger_ready:
-                logger_ready = any(r.ok is not None for r in session.liveliness().get(keys.alive("logger"), timeout=0.5))
+                logger_ready = any(
+                    r.ok is not None for r in session.liveliness().get(keys.alive("logger"), timeout=0.5)
+                )
             if time.monotonic() >= next_look:  # lockstep agents that lost their coordinator wait in silence
                 fetch(session, keys.all_histories, node.inbox, first=0, last=0, timeout=0.5)
                 next_look = time.monotonic() + 0.5

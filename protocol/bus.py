@@ -179,9 +179,10 @@ def fetch(
     last: int | None = None,
     timeout: float = 1.0,
     steps: list[int] | None = None,
+    recovery: bool = True,
 ) -> int:
     """Ask a history queryable for steps first..last, or for the given steps; replies go through the
-    inbox's validation."""
+    inbox's validation (and count as recovered, unless ``recovery`` is False: a routine read)."""
     if steps:
         selector = f"{key}?steps={','.join(str(step) for step in steps[:MAX_STEPS_ASKED])}"
     else:
@@ -190,7 +191,7 @@ def fetch(
     # No consolidation: a history replies several payloads on one key (Zenoh would keep only the last).
     for reply in session.get(selector, timeout=timeout, consolidation=zenoh.ConsolidationMode.NONE):
         if reply.ok is not None:
-            inbox.deliver(str(reply.ok.key_expr), reply.ok.payload.to_bytes())
+            inbox.deliver(str(reply.ok.key_expr), reply.ok.payload.to_bytes(), recovery)
             count += 1
     return count
 
@@ -269,10 +270,12 @@ class Inbox:
         if received is not None:
             self.queue.put(received)
 
-    def deliver(self, key: str, payload: bytes) -> None:
-        """A payload fetched by a query (not subject to the drop hook): validate and queue it."""
-        with self._lock:
-            self.recovered += 1
+    def deliver(self, key: str, payload: bytes, recovery: bool = True) -> None:
+        """A payload fetched by a query (not subject to the drop hook): validate and queue it.
+        ``recovery``: it replaces a lost one (counted as recovered), rather than being read routinely."""
+        if recovery:
+            with self._lock:
+                self.recovered += 1
         received = self._validate(key, payload)
         if received is not None:
             self.queue.put(received)
