@@ -74,6 +74,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="router endpoint (default tcp/127.0.0.1:7447, or the --secure profile's tls endpoint)",
     )
     parser.add_argument(
+        "--bus",
+        choices=("peer", "client"),
+        default="peer",
+        help="peer (default): the processes exchange data directly over loopback and meet through the "
+        "router; client: everything goes through the router, as across hosts (forced by --secure)",
+    )
+    parser.add_argument(
         "--secure",
         metavar="DIR",
         help="mutual TLS and access control from a profile made by 'anicov certs --out DIR'",
@@ -102,6 +109,7 @@ def child_command(role: str, args: argparse.Namespace, extra: list[str], identit
         args.team,
         "--connect",
         args.listen,
+        *(["--mode", "peer", "--listen", "tcp/127.0.0.1:0"] if args.bus == "peer" else []),
         "--clock",
         args.clock,
         "--speed",
@@ -202,6 +210,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"launch_team: error: {error}", file=sys.stderr)
             return EXIT_USAGE
         router_config_file = str(profile.config("router"))
+        args.bus = "client"  # the profile's certificates and access control are the router's
         args.listen = args.listen or endpoint
     args.listen = args.listen or "tcp/127.0.0.1:7447"
     out_dir = Path(args.out or Path("runs") / datetime.now().strftime("%Y%m%d-%H%M%S"))
