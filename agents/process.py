@@ -118,14 +118,6 @@ class AgentNode:
         elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
             self.finished = message
 
-    def drain(self, seconds: float) -> None:
-        """After the end of the run: take in what is still arriving for ``seconds``."""
-        until = time.monotonic() + seconds
-        while self.finished is not None and time.monotonic() < until:
-            item = self.inbox.get(timeout=0.05)
-            if item is not None:
-                self.handle(item)
-
     def apply_remaining_gos(self) -> None:
         """At the end of a run: the last go completes the map even if the end arrived first."""
         for step in sorted(self.gos):
@@ -304,13 +296,14 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
                 if wait > 0:
                     stop.wait(wait)
         # Let in-flight deltas of teammates land, so every replica ends with the same map.
-        node.drain(0.5)
+        if node.finished is not None:
+            node.inbox.drain(0.5, node.handle)
         if node.finished is not None and not lockstep:
             # Realtime: the last deltas of a teammate have no later one to reveal their loss; ask every
             # history for what follows our contiguous run, then stay a moment to answer the others' asks.
             teammates = [agent for agent in range(scenario.agents) if agent != options.agent]
             fill_gaps(session, keys, node.replica, node.inbox, to_the_end=teammates)
-            node.drain(0.5)
+            node.inbox.drain(0.5, node.handle)
         node.apply_remaining_gos()
         token.undeclare()
     counts = node.inbox.counts() | {

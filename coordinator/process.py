@@ -307,14 +307,6 @@ class Coordinator:
                     self._handle(Received("", message))
         return resume
 
-    def drain(self, seconds: float) -> None:
-        """After the end of the run: take in what is still arriving for ``seconds``."""
-        until = time.monotonic() + seconds
-        while time.monotonic() < until:
-            item = self.inbox.get(timeout=0.05)
-            if item is not None:
-                self.handle(item)
-
     def take_snapshot(self, time_now: float) -> None:
         lack = self.replica.map.lack_of_coverage()
         self.log.snapshot_times.append(time_now)
@@ -531,12 +523,12 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         # (Lockstep: nothing is in flight, the last go closed every step.)
         node.open_step = None
         if not lockstep:
-            node.drain(0.5)
+            node.inbox.drain(0.5, node.handle)
         if outcome is not None:
             publish(control_publisher, done)  # again, for whoever lost the first (it is idempotent)
         if not lockstep:  # and those lost on the way, last ones included (see fill_gaps)
             fill_gaps(session, keys, node.replica, node.inbox, to_the_end=range(scenario.agents))
-            node.drain(0.5)
+            node.inbox.drain(0.5, node.handle)
         token.undeclare()
         counts = node.inbox.counts() | {
             "map_digest": node.replica.digest(),

@@ -14,7 +14,7 @@ import queue
 import threading
 import time
 from collections import Counter
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -322,6 +322,14 @@ class Inbox:
             received = self._validate(item.key, item.payload)
             if received is not None:
                 return received
+
+    def drain(self, seconds: float, handle: Callable[[Received | Membership], None]) -> None:
+        """Hand ``handle`` everything that arrives for ``seconds`` (at the end of a run: what is in flight)."""
+        until = time.monotonic() + seconds
+        while time.monotonic() < until:
+            item = self.get(timeout=0.05)
+            if item is not None:
+                handle(item)
 
     def counts(self) -> dict[str, int]:
         with self._lock:
