@@ -39,6 +39,7 @@ from protocol.bus import (
     LossTimer,
     Membership,
     Received,
+    Relay,
     fetch,
     fill_gaps,
     open_session,
@@ -98,6 +99,7 @@ class AgentNode:
         self.gos: dict[int, StepGo] = {}  # lockstep: gos received for steps not yet taken
         self.finished: RunControl | None = None
         self.bytes_sent = 0
+        self.relay = Relay(self.keys.agent_relay(options.agent))  # realtime: teammates' steps, for when one dies
 
     # ------------------------------------------------------------ messages
 
@@ -108,6 +110,7 @@ class AgentNode:
         if isinstance(message, AgentStep):  # realtime: teammates' deltas, applied as they come
             if message.agent != self.options.agent:
                 self.replica.apply(message.delta)
+                self.relay.add(message.agent, message.delta.seq, item.payload)
         elif isinstance(message, StepGo):
             if message.step >= self.step:
                 self.gos[message.step] = message
@@ -212,6 +215,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             # Remote only: our own deltas are applied when made, an echo would only cost a decode.
             session.declare_subscriber(keys.all_steps, node.inbox.on_sample, allowed_origin=zenoh.Locality.REMOTE)
             session.declare_subscriber(keys.objectives, node.inbox.on_sample)
+            session.declare_queryable(keys.agent_relay(options.agent), node.relay.serve)
         session.declare_subscriber(keys.control, node.inbox.on_sample)
         step_publisher = team_publisher(session, keys.agent_step(options.agent))
         token = session.liveliness().declare_token(keys.alive("agent", options.agent))

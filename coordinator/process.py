@@ -31,6 +31,7 @@ from protocol.bus import (
     LossTimer,
     Membership,
     Received,
+    Relay,
     fetch,
     fill_gaps,
     open_session,
@@ -122,6 +123,7 @@ class Coordinator:
         self.states_by_step: dict[int, dict[int, AgentState]] = {}  # lockstep: states not yet sent in a go
         self.closed_states: dict[int, AgentState] = self.states_by_step.get(-1, {})  # the hellos, for go 0
         self.lock = threading.Lock()  # the snapshot queryable reads the replica from Zenoh's thread
+        self.relay = Relay(self.keys.coordinator_relay)
 
     def snapshot_payload(self) -> bytes:
         """The replica with the last known poses, for a late or restarted process (Zenoh's thread)."""
@@ -155,6 +157,8 @@ class Coordinator:
         if isinstance(message, AgentStep):
             self._take_delta(message.delta)
             self._take_state(message.state)
+            if self.open_step is None and item.payload:  # realtime: kept for when its sender dies
+                self.relay.add(message.agent, message.delta.seq, item.payload)
         elif isinstance(message, MapDelta):
             self._take_delta(message)
         elif isinstance(message, AgentState):  # a hello (step −1), or a state from a history
@@ -350,6 +354,8 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         go_history = History(keys.go_history)
         loss = LossTimer()
         session.declare_queryable(keys.go_history, go_history.serve)
+        if not lockstep:
+            session.declare_queryable(keys.coordinator_relay, node.relay.serve)
 
         def publish_go(go: StepGo) -> None:
             payload = encode(go)

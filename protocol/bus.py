@@ -21,7 +21,7 @@ from pathlib import Path
 import zenoh
 
 from protocol.keys import TeamKeys, agent_of_key
-from protocol.messages import Limits, Message, ProtocolError, decode
+from protocol.messages import AgentStep, Limits, Message, ProtocolError, decode
 from protocol.replica import MapReplica
 
 log = logging.getLogger("anicov.bus")
@@ -86,6 +86,7 @@ def team_publisher(session: zenoh.Session, key: str) -> zenoh.Publisher:
 class Received:
     key: str
     message: Message
+    payload: bytes = b""  # as it came: a relay keeps teammates' steps to serve them again
 
 
 MAX_STEPS_ASKED = 2000
@@ -140,6 +141,45 @@ class History:
             query.reply(self.key, payload)
 
 
+RELAY_STEPS = 1000
+"""Steps of each teammate a realtime process keeps for the relay: many gap checks' worth even at
+speed 20 (200 steps a second), a few MB per teammate."""
+
+
+class Relay:
+    """Teammates' recent steps, served in their place once they are gone (realtime).
+
+    A delta lost on the way to one replica is normally fetched from its
+    sender's history. If the sender has died meanwhile, that history is gone
+    too, but its teammates received the delta: each keeps the last
+    ``capacity`` steps of every teammate and answers ``?agent=I;steps=…`` (or
+    ``?agent=I;from=K``) on its own relay key. A relayed step is trusted as
+    far as the replier is (a team member, authenticated in the secure profile),
+    and is asked for only when the agent's own history does not answer.
+    """
+
+    def __init__(self, key: str, capacity: int = RELAY_STEPS) -> None:
+        self.key = key
+        self.capacity = capacity
+        self._steps: dict[int, History] = {}
+
+    def add(self, agent: int, seq: int, payload: bytes) -> None:
+        history = self._steps.get(agent)
+        if history is None:
+            history = self._steps.setdefault(agent, History(self.key, self.capacity))
+        history.add(seq, payload)
+
+    def serve(self, query: zenoh.Query) -> None:
+        """Reply with the kept steps of the agent named by ``?agent=``; anything malformed gets no reply."""
+        try:
+            agent = int(str(query.parameters.get("agent")))
+        except ValueError:
+            return
+        history = self._steps.get(agent)
+        if history is not None:
+            history.serve(query)
+
+
 class LossTimer:
     """When silence means loss: a few times the usual step time, never under a floor.
 
@@ -180,18 +220,22 @@ def fetch(
     timeout: float = 1.0,
     steps: list[int] | None = None,
     recovery: bool = True,
+    relayed: int | None = None,
 ) -> int:
     """Ask a history queryable for steps first..last, or for the given steps; replies go through the
-    inbox's validation (and count as recovered, unless ``recovery`` is False: a routine read)."""
+    inbox's validation (and count as recovered, unless ``recovery`` is False: a routine read).
+    ``relayed``: ask relays (``key`` then names them) for that agent's steps."""
     if steps:
         selector = f"{key}?steps={','.join(str(step) for step in steps[:MAX_STEPS_ASKED])}"
     else:
         selector = f"{key}?from={first}" + (f";to={last}" if last is not None else "")
+    if relayed is not None:
+        selector += f";agent={relayed}"
     count = 0
     # No consolidation: a history replies several payloads on one key (Zenoh would keep only the last).
     for reply in session.get(selector, timeout=timeout, consolidation=zenoh.ConsolidationMode.NONE):
         if reply.ok is not None:
-            inbox.deliver(str(reply.ok.key_expr), reply.ok.payload.to_bytes(), recovery)
+            inbox.deliver(str(reply.ok.key_expr), reply.ok.payload.to_bytes(), recovery, relayed)
             count += 1
     return count
 
@@ -210,13 +254,22 @@ def fill_gaps(
     the agents whose every delta after the replica's contiguous run is asked
     for. Replies go through the inbox like any message (validated, counted);
     the replica applies each (agent, sequence) once, however often it comes.
+    An agent whose history does not answer has died: its teammates' relays
+    are asked instead (see :class:`Relay`).
     """
     asked = 0
     for agent, missing in replica.gaps().items():
-        asked += fetch(session, keys.agent_history(agent), inbox, steps=missing)
+        got = fetch(session, keys.agent_history(agent), inbox, steps=missing)
+        if not got:
+            got = fetch(session, keys.all_relays, inbox, steps=missing, relayed=agent)
+        asked += got
     for agent in to_the_end:
         applied = replica.applied.get(agent)
-        asked += fetch(session, keys.agent_history(agent), inbox, first=applied.contiguous + 1 if applied else 0)
+        first = applied.contiguous + 1 if applied else 0
+        got = fetch(session, keys.agent_history(agent), inbox, first=first)
+        if not got:
+            got = fetch(session, keys.all_relays, inbox, first=first, relayed=agent)
+        asked += got
     return asked
 
 
@@ -250,6 +303,7 @@ class Inbox:
         self._drop_random = __import__("random").Random(seed)
         self.dropped = 0
         self.recovered = 0
+        self.relayed = 0  # accepted from a relay: a dead teammate's step
 
     def on_sample(self, sample: zenoh.Sample) -> None:
         key = str(sample.key_expr)
@@ -270,29 +324,35 @@ class Inbox:
         if received is not None:
             self.queue.put(received)
 
-    def deliver(self, key: str, payload: bytes, recovery: bool = True) -> None:
+    def deliver(self, key: str, payload: bytes, recovery: bool = True, relayed: int | None = None) -> None:
         """A payload fetched by a query (not subject to the drop hook): validate and queue it.
-        ``recovery``: it replaces a lost one (counted as recovered), rather than being read routinely."""
+        ``recovery``: it replaces a lost one (counted as recovered), rather than being read routinely.
+        ``relayed``: it came from a relay, which may answer only with that agent's steps."""
         if recovery:
             with self._lock:
                 self.recovered += 1
-        received = self._validate(key, payload)
+        received = self._validate(key, payload, relayed)
         if received is not None:
+            if relayed is not None:
+                with self._lock:
+                    self.relayed += 1
             self.queue.put(received)
 
-    def _validate(self, key: str, payload: bytes) -> Received | None:
+    def _validate(self, key: str, payload: bytes, relayed: int | None = None) -> Received | None:
         try:
             message = decode(payload, self.limits)
-            sender = agent_of_key(key)
             agent = getattr(message, "agent", None)
-            if "/agent/" in key and agent is not None and agent != sender:
+            if relayed is not None:
+                if not isinstance(message, AgentStep) or agent != relayed:
+                    raise ProtocolError("wrong-relay", f"{key} relayed {type(message).__name__} for agent {agent}")
+            elif "/agent/" in key and agent is not None and agent != agent_of_key(key):
                 raise ProtocolError("wrong-sender", f"agent {agent} published on {key}")
         except ProtocolError as error:
             self._reject(error.reason, key, str(error))
             return None
         with self._lock:
             self.accepted += 1
-        return Received(key, message)
+        return Received(key, message, payload)
 
     def on_liveliness(self, sample: zenoh.Sample) -> None:
         agent = agent_of_key(str(sample.key_expr))
@@ -338,6 +398,7 @@ class Inbox:
                 "rejected": sum(self.rejected.values()),
                 "dropped": self.dropped,
                 "recovered": self.recovered,
+                "relayed": self.relayed,
                 "bytes_received": self.bytes_received,
                 **{f"rejected.{k}": v for k, v in self.rejected.items()},
             }

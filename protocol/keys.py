@@ -5,11 +5,14 @@ agent/<id>/step             AgentStep            agent → all         one step:
                             AgentState           agent → all         hello (step −1): its pose at t_0
 agent/<id>/history          (queryable)          agent               its recent steps
 agent/<id>/snapshot         (queryable)          agent               its replica: for a restarted coordinator
+agent/<id>/relay            (queryable)          agent               realtime: teammates' recent steps, served
+                                                                     for one that died (?agent=<id>;steps=…)
 coordinator/go              StepGo               coordinator → all   lockstep: step k may start, with every
                                                                      step k−1 delta and state, targets on replans
 coordinator/objectives      Objectives           coordinator → all   realtime: the latest targets
 coordinator/snapshot        (queryable)          coordinator         map, sequences, poses: late joiners
 coordinator/history         (queryable)          coordinator         recent gos and the end of the run
+coordinator/relay           (queryable)          coordinator         realtime: as agent/<id>/relay
 run/control                 RunControl           coordinator → all   run done / aborted
 run/status                  RunControl           coordinator → all   progress (e_D, step)
 alive/<role>/<id>           liveliness token     every process       agent/<id>, coordinator/0, logger/0
@@ -50,6 +53,17 @@ class TeamKeys:
 
     def agent_history(self, agent: int) -> str:
         return f"{self.prefix}/agent/{agent}/history"
+
+    def agent_relay(self, agent: int) -> str:
+        return f"{self.prefix}/agent/{agent}/relay"
+
+    @property
+    def coordinator_relay(self) -> str:
+        return f"{self.prefix}/coordinator/relay"
+
+    @property
+    def all_relays(self) -> str:
+        return f"{self.prefix}/**/relay"
 
     @property
     def all_histories(self) -> str:

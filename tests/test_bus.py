@@ -7,9 +7,9 @@ import pytest
 import zenoh
 
 from agents.process import END_ONLY
-from protocol.bus import History, Inbox, LossTimer, Received, fetch, fill_gaps, zenoh_config
+from protocol.bus import History, Inbox, LossTimer, Received, Relay, fetch, fill_gaps, zenoh_config
 from protocol.keys import TeamKeys
-from protocol.messages import Limits, MapDelta, RunControl, encode
+from protocol.messages import AgentState, AgentStep, Limits, MapDelta, RunControl, encode
 from protocol.replica import MapReplica
 from tests.teamrun import free_port, unique_team, wait_for
 
@@ -100,6 +100,55 @@ def test_fill_gaps_fetches_known_missing_deltas_and_at_the_end_the_last_ones(tea
     for seq in range(50):
         expected.apply(delta(1, seq))
     assert replica.digest() == expected.digest()  # every delta once: the sum of all published
+
+
+def agent_step(agent: int, seq: int) -> AgentStep:
+    pose = (1.0, 2.0, 0.5)
+    return AgentStep(delta(agent, seq), AgentState(agent, seq, pose, 1.0, 0.1, 0.0, pose))
+
+
+def test_a_dead_agents_lost_steps_come_from_a_teammates_relay(sessions):
+    """Agent 0 died (no history answers); agent 2 kept its steps 0..9 and relays them."""
+    server, asker = sessions
+    keys = TeamKeys(unique_team())
+    relay = Relay(keys.agent_relay(2))
+    for seq in range(10):
+        relay.add(0, seq, encode(agent_step(0, seq)))
+    queryable = server.declare_queryable(keys.agent_relay(2), relay.serve)
+    try:
+        assert wait_for(lambda: fetch(asker, keys.all_relays, Inbox(LIMITS), steps=[0], relayed=0) == 1, timeout=5)
+        replica = MapReplica(20, 20, 1.0, 1.0)
+        for seq in (0, 1, 2, 3, 6):
+            replica.apply(delta(0, seq))
+        inbox = Inbox(LIMITS)
+        assert fill_gaps(asker, keys, replica, inbox) == 2  # 4 and 5, from the relay
+        for item in drain(inbox):
+            replica.apply(item.message.delta)
+        assert replica.gaps() == {} and replica.contiguous() == {"0": 6}
+        assert fill_gaps(asker, keys, replica, inbox, to_the_end=[0]) == 3  # 7..9: the last ones
+        for item in drain(inbox):
+            replica.apply(item.message.delta)
+        assert replica.contiguous() == {"0": 9} and inbox.counts()["rejected"] == 0
+        expected = MapReplica(20, 20, 1.0, 1.0)
+        for seq in range(10):
+            expected.apply(delta(0, seq))
+        assert replica.digest() == expected.digest()
+        # The relay answers only for the agent asked about, and nothing for a malformed or unknown one.
+        assert fetch(asker, keys.all_relays, inbox, steps=[4], relayed=1) == 0
+        assert [r for r in asker.get(f"{keys.all_relays}?agent=x;steps=4", timeout=1.0) if r.ok is not None] == []
+    finally:
+        queryable.undeclare()
+
+
+def test_a_relay_may_answer_only_with_a_step_of_the_agent_asked_about():
+    inbox = Inbox(LIMITS)
+    inbox.deliver("anicov/t/agent/2/relay", encode(agent_step(1, 0)), relayed=0)  # another agent's step
+    inbox.deliver("anicov/t/agent/2/relay", encode(delta(0, 0)), relayed=0)  # not a step
+    inbox.deliver("anicov/t/agent/2/relay", encode(RunControl("done", 5, True, 0.0)), relayed=0)
+    assert drain(inbox) == []
+    assert inbox.counts()["rejected.wrong-relay"] == 3
+    inbox.deliver("anicov/t/agent/2/relay", encode(agent_step(0, 0)), relayed=0)
+    assert [item.message.agent for item in drain(inbox)] == [0]
 
 
 def test_the_inbox_rejects_a_message_published_on_another_agents_key():

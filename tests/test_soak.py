@@ -58,11 +58,6 @@ def test_soak_lockstep_paper_run_with_10_percent_loss_and_three_coordinator_kill
     assert wait_for(lambda: processes_of(team) == [], timeout=10)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known gap (issue 5): a delta of an agent that then dies, dropped on the way to some replica, "
-    "cannot be fetched from its history any more; gap filling from a live teammate's replica is not written",
-)
 def test_soak_realtime_eight_agents_with_loss_a_dead_agent_and_a_coordinator_kill(tmp_path):
     team = unique_team()
     out = tmp_path / "run"
