@@ -41,6 +41,7 @@ from protocol.bus import (
     Received,
     Relay,
     fetch,
+    fetch_snapshot,
     fill_gaps,
     open_session,
     team_publisher,
@@ -53,11 +54,8 @@ from protocol.messages import (
     Limits,
     MapDelta,
     Objectives,
-    ProtocolError,
     RunControl,
-    Snapshot,
     StepGo,
-    decode,
     encode,
 )
 from protocol.replica import MapReplica
@@ -178,28 +176,34 @@ class AgentNode:
         """A restarted robot: if the coordinator's snapshot knows this agent, resume where it stopped.
 
         The map and the applied sequences come from the snapshot (deltas arriving
-        meanwhile are applied once); the step continues after this agent's last
-        delta, and the simulated robot restarts from its last known pose (a real
-        robot reads its pose from its localisation instead).
+        meanwhile are applied once). The last steps before the crash may have
+        reached teammates but not the coordinator: they come back from the
+        relays, so that no sequence is ever used for two different deltas. The
+        step continues after this agent's last delta anyone holds, and the
+        simulated robot restarts from its last known pose (a real robot reads
+        its pose from its localisation instead).
         """
-        try:
-            for reply in session.get(self.keys.snapshot, timeout=1.0):
-                if reply.ok is None:
-                    continue
-                snapshot = decode(reply.ok.payload.to_bytes(), self.limits, expected="snapshot")
-                assert isinstance(snapshot, Snapshot)
-                own = snapshot.applied.get(self.options.agent)
-                if own is None:
-                    return False  # a fresh run: nothing of ours to resume
-                self.replica.load(snapshot)
-                self.step = own[0] + 1
-                pose = snapshot.poses.get(self.options.agent)
-                if pose is not None and isinstance(self.robot, SimulatedUnicycle):
-                    self.robot = SimulatedUnicycle(pose, self.law)
-                return True
-        except ProtocolError as error:
-            log.warning("snapshot rejected: %s", error)
-        return False
+        me = self.options.agent
+        snapshot = fetch_snapshot(session, self.keys.snapshot, self.limits, timeout=1.0)
+        own = snapshot.applied.get(me) if snapshot is not None else None
+        if snapshot is None or own is None:
+            return False  # a fresh run: nothing of ours to resume
+        self.replica.load(snapshot)
+        contiguous, extras = own
+        self.step = max((contiguous, *extras)) + 1
+        pose = snapshot.poses.get(me)
+        fetch(session, self.keys.all_relays, self.inbox, first=contiguous + 1, relayed=me)
+        while (item := self.inbox.get(timeout=0)) is not None:
+            if isinstance(item, Received) and isinstance(item.message, AgentStep) and item.message.agent == me:
+                self.replica.apply(item.message.delta)
+                if item.message.state.step >= self.step:
+                    self.step = item.message.state.step + 1
+                    pose = item.message.state.next_pose
+            else:
+                self.handle(item)
+        if pose is not None and isinstance(self.robot, SimulatedUnicycle):
+            self.robot = SimulatedUnicycle(pose, self.law)
+        return True
 
 
 def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, stop: StopFlag) -> int:

@@ -20,18 +20,15 @@ import zenoh
 from anicov.lifecycle import EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 from anicov.recording import RunRecorder
 from anicov.scenario import Scenario
-from protocol.bus import Inbox, Membership, Received, fetch, open_session, write_counts
+from protocol.bus import Inbox, Membership, Received, fetch, fetch_snapshot, open_session, write_counts
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
     AgentStep,
     Limits,
     Objectives,
-    ProtocolError,
     RunControl,
-    Snapshot,
     StepGo,
-    decode,
 )
 from protocol.replica import MapReplica
 
@@ -132,19 +129,13 @@ class TeamLogger:
 
     def load_snapshot(self, session: zenoh.Session, keys: TeamKeys) -> None:
         """A late logger starts from the coordinator's map."""
-        for reply in session.get(keys.snapshot, timeout=5.0):
-            if reply.ok is None:
-                continue
-            try:
-                snapshot = decode(reply.ok.payload.to_bytes(), self.limits, expected="snapshot")
-            except ProtocolError as error:
-                log.warning("snapshot rejected: %s", error)
-                continue
-            assert isinstance(snapshot, Snapshot)
-            self.replica.load(snapshot)
-            if snapshot.applied:  # a late start: the gos before the snapshot's map are already in it
-                self.next_go = max(self.next_go, min(seq for seq, _ in snapshot.applied.values()) + 2)
-            log.info("loaded the coordinator's snapshot (e_D = %.4f)", self.replica.map.domain_error())
+        snapshot = fetch_snapshot(session, keys.snapshot, self.limits, timeout=5.0)
+        if snapshot is None:
+            return
+        self.replica.load(snapshot)
+        if snapshot.applied:  # a late start: the gos before the snapshot's map are already in it
+            self.next_go = max(self.next_go, min(seq for seq, _ in snapshot.applied.values()) + 2)
+        log.info("loaded the coordinator's snapshot (e_D = %.4f)", self.replica.map.domain_error())
 
     def finish(self) -> None:
         """The run's final map and its end, then flush everything to the sinks."""

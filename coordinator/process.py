@@ -33,6 +33,7 @@ from protocol.bus import (
     Received,
     Relay,
     fetch,
+    fetch_snapshot,
     fill_gaps,
     open_session,
     team_publisher,
@@ -45,11 +46,9 @@ from protocol.messages import (
     Limits,
     MapDelta,
     Objectives,
-    ProtocolError,
     RunControl,
     Snapshot,
     StepGo,
-    decode,
     encode,
 )
 from protocol.replica import MapReplica
@@ -569,15 +568,8 @@ def alive_agents(session: zenoh.Session, keys: TeamKeys, agents: int) -> set[int
 def member_snapshot(session: zenoh.Session, keys: TeamKeys, limits: Limits, members: set[int]) -> Snapshot | None:
     """The replica of the first member that answers, or None."""
     for agent in sorted(members):
-        for reply in session.get(keys.agent_snapshot(agent), timeout=2.0):
-            if reply.ok is None:
-                continue
-            try:
-                snapshot = decode(reply.ok.payload.to_bytes(), limits, expected="snapshot")
-            except ProtocolError as error:
-                log.warning("agent %d's snapshot rejected: %s", agent, error)
-                continue
-            assert isinstance(snapshot, Snapshot)
+        snapshot = fetch_snapshot(session, keys.agent_snapshot(agent), limits, timeout=2.0)
+        if snapshot is not None:
             return snapshot
     return None
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import zenoh
 
 from protocol.keys import TeamKeys, agent_of_key
-from protocol.messages import AgentStep, Limits, Message, ProtocolError, decode
+from protocol.messages import AgentStep, Limits, Message, ProtocolError, Snapshot, decode
 from protocol.replica import MapReplica
 
 log = logging.getLogger("anicov.bus")
@@ -238,6 +238,21 @@ def fetch(
             inbox.deliver(str(reply.ok.key_expr), reply.ok.payload.to_bytes(), recovery, relayed)
             count += 1
     return count
+
+
+def fetch_snapshot(session: zenoh.Session, key: str, limits: Limits, timeout: float) -> Snapshot | None:
+    """The first valid snapshot a snapshot queryable answers with; a malformed one is logged and skipped."""
+    for reply in session.get(key, timeout=timeout):
+        if reply.ok is None:
+            continue
+        try:
+            snapshot = decode(reply.ok.payload.to_bytes(), limits, expected="snapshot")
+        except ProtocolError as error:
+            log.warning("snapshot from %s rejected: %s", key, error)
+            continue
+        assert isinstance(snapshot, Snapshot)
+        return snapshot
+    return None
 
 
 GAP_CHECK_PERIOD = 0.5

@@ -348,6 +348,7 @@ def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_p
         time.sleep(2.0)
         os.kill(agent_pid(team, 1), signal.SIGKILL)
         time.sleep(1.0)
+        spawned_at = time.time()
         restarted = subprocess.Popen(
             [
                 sys.executable,
@@ -394,6 +395,8 @@ def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_p
     digests |= {json.loads((out / "logs" / f"agent-{i}.counts.json").read_text())["map_digest"] for i in (0, 2, 3)}
     assert len(digests) == 1, digests  # every replica holds the same map, bit for bit
     assert json.loads((out / "summary.json").read_text())["completed"] is True
+    rejoined = [line for line in (out / "logs" / "coordinator.log").read_text().splitlines() if "rejoined" in line]
+    (out / "rejoin_seconds.txt").write_text(f"{log_time(rejoined[0]) - spawned_at:.3f}\n")  # process start → member
 
 
 def assert_every_replica_holds_every_published_delta_once(out, agents: int) -> list[dict]:
