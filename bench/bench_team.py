@@ -2,8 +2,11 @@
 
 Each team runs as real processes through ``launch_team.py`` on loopback; the
 figures come from the coordinator's counters (stepping time, bytes it
-received) and the launcher's wall time. The ping-pong is measured in the same
-run (bench/pingpong.py). Prints a Markdown table.
+received) and the launcher's wall time. Measured in the same run: the bare
+Zenoh ping-pong through a router (bench/pingpong.py), the same between two
+peers (the transport a team uses), and the step's exchange with no work in it
+(bench/fanout.py: one go to N echo processes and their N replies). Prints a
+Markdown table.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
+from bench.fanout import fan_out  # noqa: E402
 from bench.machine import describe_machine  # noqa: E402
 from bench.pingpong import free_port, ping  # noqa: E402
 
@@ -75,6 +79,20 @@ def main() -> None:
         f"bare Zenoh ping-pong between two processes via a router: median {rtt['median_us']:.0f} µs, "
         f"p90 {rtt['p90_us']:.0f} µs"
     )
+    peer = fan_out(1, 2000, 256, 256)
+    print(f"bare Zenoh ping-pong between two peers (as a team runs): median {peer['median_us']:.0f} µs")
+    floor = fan_out(4, 2000, 10_700, 3_070, handoff=True)
+    print(
+        f"a lockstep step's exchange with no work (go of 10.7 kB to 4 echo processes, 4 replies of 3.1 kB): "
+        f"median {floor['median_us']:.0f} µs = {floor['median_us'] / peer['median_us']:.1f} peer round trips"
+    )
+    for agents in (1, 2):  # the same per-step cost with fewer processes sharing the two cores
+        row = run_team(agents, None)
+        per_step = row["stepping_s"] / row["steps"] * 1e6
+        print(
+            f"N = {agents}: {per_step:.0f} µs a step = {per_step / peer['median_us']:.1f} peer / "
+            f"{per_step / rtt['median_us']:.1f} router round trips ({row['steps']} steps)"
+        )
     # Without and with the logger, interleaved, so a slow spell of a shared machine hits both alike.
     plain: list[dict[str, float]] = []
     recorded: list[dict[str, float]] = []
@@ -83,7 +101,8 @@ def main() -> None:
         recorded.append(run_team(4, None, record=True))
     print(f"\nN = 4, paper scenario, {args.repeats} runs each (median, then min – max):")
     print(
-        "| variant | steps | stepping time (s) | launcher wall (s) | steps/s | round trips per step | bytes per step |"
+        "| variant | steps | stepping time (s) | launcher wall (s) | steps/s | round trips per step (router / peer)"
+        " | bytes per step |"
     )
     print("|---|---|---|---|---|---|---|")
     for name, runs in (("no logger", plain), ("logger recording", recorded)):
@@ -91,10 +110,12 @@ def main() -> None:
         wall = [run["wall_s"] for run in runs]
         rate = [run["steps_per_s"] for run in runs]
         trips = [1e6 / r / rtt["median_us"] for r in rate]
+        peer_trips = [1e6 / r / peer["median_us"] for r in rate]
         print(
             f"| {name} | {runs[0]['steps']} | {median(stepping):.1f} ({min(stepping):.1f} – {max(stepping):.1f}) | "
             f"{median(wall):.1f} ({min(wall):.1f} – {max(wall):.1f}) | {median(rate):.0f} | "
-            f"{median(trips):.1f} | {median([run['bus_bytes_per_step'] for run in runs]):,.0f} |"
+            f"{median(trips):.1f} / {median(peer_trips):.1f} | "
+            f"{median([run['bus_bytes_per_step'] for run in runs]):,.0f} |"
         )
     ratios = [
         with_logger["steps_per_s"] / without["steps_per_s"]
