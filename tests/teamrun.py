@@ -9,6 +9,8 @@ import subprocess
 import sys
 import time
 import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -38,6 +40,27 @@ def launcher_command(*args: str, team: str | None = None, port: int | None = Non
     ]
 
 
+@contextmanager
+def running(command: list[str]) -> Iterator[subprocess.Popen[str]]:
+    """A process in the background (output piped), killed if still running at the end of the block."""
+    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        yield process
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+
+
+def launched_team(*args: str, team: str | None = None, port: int | None = None):
+    """``launch_team.py`` in the background: ``with launched_team(...) as process:``."""
+    return running(launcher_command(*args, team=team, port=port))
+
+
+def anicov_command(*args: str) -> list[str]:
+    return [sys.executable, "-m", "anicov.cli", *args]
+
+
 def run(command: list[str], timeout: float = 300) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         command, cwd=ROOT, capture_output=True, text=True, timeout=timeout, env=os.environ | {"PYTHONUNBUFFERED": "1"}
@@ -45,7 +68,7 @@ def run(command: list[str], timeout: float = 300) -> subprocess.CompletedProcess
 
 
 def anicov(*args: str, timeout: float = 300) -> subprocess.CompletedProcess[str]:
-    return run([sys.executable, "-m", "anicov.cli", *args], timeout=timeout)
+    return run(anicov_command(*args), timeout=timeout)
 
 
 def processes_of(team: str) -> list[str]:

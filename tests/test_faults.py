@@ -8,7 +8,6 @@ import random
 import re
 import signal
 import subprocess
-import sys
 import time
 from datetime import datetime
 
@@ -32,7 +31,19 @@ from protocol.messages import (
     decode,
     encode,
 )
-from tests.teamrun import ROOT, anicov, free_port, launcher_command, processes_of, unique_team, wait_for, write_scenario
+from tests.teamrun import (
+    anicov,
+    anicov_command,
+    free_port,
+    launched_team,
+    launcher_command,
+    processes_of,
+    run,
+    running,
+    unique_team,
+    wait_for,
+    write_scenario,
+)
 
 
 def agents_started(logs, agents: int) -> bool:
@@ -66,22 +77,12 @@ def test_team_survives_an_agent_killed_mid_run(tmp_path, clock):
     team = unique_team()
     out = tmp_path / "run"
     extra = ["--speed", "40"] if clock == "realtime" else []
-    process = subprocess.Popen(
-        launcher_command("--n", "4", "--seed", "0", "--clock", clock, *extra, "--out", str(out), team=team),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
+    with launched_team("--n", "4", "--seed", "0", "--clock", clock, *extra, "--out", str(out), team=team) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)  # well into the run
         killed_at = time.time()
         os.kill(agent_pid(team, 2), signal.SIGKILL)
         stdout, stderr = process.communicate(timeout=400)
-    finally:
-        if process.poll() is None:
-            process.kill()
     assert process.returncode == 0, stderr + stdout
     assert "lost on the way agent-2" in stdout
     summary = json.loads((out / "summary.json").read_text())
@@ -219,15 +220,8 @@ def fuzz_a_running_team(tmp_path, domain: list[float], at_least: int, at_most: i
     ]
     port = free_port()
     out = tmp_path / "team"
-    process = subprocess.Popen(
-        launcher_command("--config", str(config), "--out", str(out), team=keys.team, port=port),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
     sent = 0
-    try:
+    with launched_team("--config", str(config), "--out", str(out), team=keys.team, port=port) as process:
         assert wait_for(lambda: agents_started(out / "logs", 2), timeout=120)
         with zenoh.open(zenoh_config("client", connect=[f"tcp/127.0.0.1:{port}"])) as session:
             publishers = [
@@ -240,9 +234,6 @@ def fuzz_a_running_team(tmp_path, domain: list[float], at_least: int, at_most: i
                 if process.poll() is not None:
                     break
         stdout, stderr = process.communicate(timeout=300)
-    finally:
-        if process.poll() is None:
-            process.kill()
     assert sent >= at_least
     assert process.returncode == 0, stderr + stdout
     # The map, the trajectories, everything equals the run without the noise.
@@ -281,46 +272,18 @@ def test_a_late_logger_catches_up_from_the_snapshot_and_records_the_full_final_m
     team = unique_team()
     port = free_port()
     out = tmp_path / "team"
-    process = subprocess.Popen(
-        launcher_command("--config", str(config), "--out", str(out), "--no-record", team=team, port=port),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    recording = tmp_path / "late.rrd"
+    late_logger = anicov_command(
+        "logger", "--team", team, "--config", str(config), "--connect", f"tcp/127.0.0.1:{port}", "--out", str(recording)
     )
-    logger = None
-    try:
+    with launched_team("--config", str(config), "--out", str(out), "--no-record", team=team, port=port) as process:
         assert wait_for(lambda: agents_started(out / "logs", 3), timeout=120)
         time.sleep(0.5)  # the team is under way before the logger exists (and it takes a second to start)
-        recording = tmp_path / "late.rrd"
-        logger = subprocess.Popen(
-            [
-                sys.executable,
-                "-m",
-                "anicov.cli",
-                "logger",
-                "--team",
-                team,
-                "--config",
-                str(config),
-                "--connect",
-                f"tcp/127.0.0.1:{port}",
-                "--out",
-                str(recording),
-            ],
-            cwd=ROOT,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
-        stdout, stderr = process.communicate(timeout=300)
-        assert process.returncode == 0, stderr + stdout
-        _, logger_err = logger.communicate(timeout=60)
-        assert logger.returncode == 0, logger_err
-    finally:
-        for child in (process, logger):
-            if child is not None and child.poll() is None:
-                child.kill()
+        with running(late_logger) as logger:
+            stdout, stderr = process.communicate(timeout=300)
+            assert process.returncode == 0, stderr + stdout
+            _, logger_err = logger.communicate(timeout=60)
+            assert logger.returncode == 0, logger_err
     loaded = re.search(r"loaded the coordinator's snapshot \(e_D = ([0-9.]+)\)", logger_err)
     assert loaded and float(loaded.group(1)) > 0.0  # it joined mid-run, not after the end
     content = summarise_recording(recording)
@@ -334,56 +297,20 @@ def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_p
     team = unique_team()
     port = free_port()
     out = tmp_path / "run"
-    process = subprocess.Popen(
-        launcher_command(
-            "--n", "4", "--seed", "0", "--clock", "realtime", "--speed", "40", "--out", str(out), team=team, port=port
-        ),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    restarted = None
-    try:
+    agent_again = anicov_command(
+        "agent", "--team", team, "--id", "1", "--n", "4", "--seed", "0", "--clock", "realtime", "--speed", "40",
+        "--connect", f"tcp/127.0.0.1:{port}", "--counts", str(tmp_path / "restarted.json"),
+    )  # fmt: skip
+    realtime = ("--n", "4", "--seed", "0", "--clock", "realtime", "--speed", "40", "--out", str(out))
+    with launched_team(*realtime, team=team, port=port) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)
         os.kill(agent_pid(team, 1), signal.SIGKILL)
         time.sleep(1.0)
         spawned_at = time.time()
-        restarted = subprocess.Popen(
-            [
-                sys.executable,
-                "-m",
-                "anicov.cli",
-                "agent",
-                "--team",
-                team,
-                "--id",
-                "1",
-                "--n",
-                "4",
-                "--seed",
-                "0",
-                "--clock",
-                "realtime",
-                "--speed",
-                "40",
-                "--connect",
-                f"tcp/127.0.0.1:{port}",
-                "--counts",
-                str(tmp_path / "restarted.json"),
-            ],
-            cwd=ROOT,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
-        stdout, stderr = process.communicate(timeout=400)
-        _, restarted_log = restarted.communicate(timeout=60)
-    finally:
-        for child in (process, restarted):
-            if child is not None and child.poll() is None:
-                child.kill()
+        with running(agent_again) as restarted:
+            stdout, stderr = process.communicate(timeout=400)
+            _, restarted_log = restarted.communicate(timeout=60)
     assert process.returncode == 0, stderr + stdout
     assert restarted.returncode == 0, restarted_log
     resumed = re.search(r"resumes from the coordinator's snapshot at step (\d+)", restarted_log)
@@ -423,25 +350,8 @@ def test_lost_messages_are_recovered_and_every_replica_ends_bit_identical(tmp_pa
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
     assert engine.returncode == 0
     out = tmp_path / "team"
-    launched = subprocess.run(
-        launcher_command(
-            "--config",
-            str(config),
-            "--out",
-            str(out),
-            "--no-record",
-            "--drop-rate",
-            "0.05",
-            "--clock",
-            clock,
-            "--speed",
-            "40",
-        ),
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=400,
-    )
+    lossy = ("--config", str(config), "--out", str(out), "--no-record", "--drop-rate", "0.05", "--clock", clock)
+    launched = run(launcher_command(*lossy, "--speed", "40"), timeout=400)
     assert launched.returncode == 0, launched.stderr + launched.stdout
     if clock == "lockstep":
         for name in ("trajectory.csv", "summary.json"):
@@ -475,21 +385,11 @@ def test_a_dead_agents_lost_deltas_come_from_its_teammates_relays(tmp_path):
     with the same map, holding every delta of agent 2 that any replica received."""
     team = unique_team()
     out = tmp_path / "run"
-    process = subprocess.Popen(
-        launcher_command(*REALTIME_WITH_LOSS, "--out", str(out), team=team),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
+    with launched_team(*REALTIME_WITH_LOSS, "--out", str(out), team=team) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)  # well into the run
         os.kill(agent_pid(team, 2), signal.SIGKILL)
         stdout, stderr = process.communicate(timeout=400)
-    finally:
-        if process.poll() is None:
-            process.kill()
     assert process.returncode == 0, stderr + stdout
     assert json.loads((out / "summary.json").read_text())["completed"] is True
     coordinator = json.loads((out / "coordinator_counts.json").read_text())
@@ -517,14 +417,7 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     team = unique_team()
     out = tmp_path / "run"
     extra = ["--speed", "40"] if clock == "realtime" else []
-    process = subprocess.Popen(
-        launcher_command("--n", "4", "--seed", "0", "--clock", clock, *extra, "--out", str(out), team=team),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
+    with launched_team("--n", "4", "--seed", "0", "--clock", clock, *extra, "--out", str(out), team=team) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)  # well into the run
         if agent_dies_first:
@@ -533,9 +426,6 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
         killed_at = time.time()
         os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
         stdout, stderr = process.communicate(timeout=400)
-    finally:
-        if process.poll() is None:
-            process.kill()
     assert process.returncode == 0, stderr + stdout
     assert "coordinator     killed and restarted 1 time(s)" in stdout
     if agent_dies_first:

@@ -110,29 +110,11 @@ def test_serve_hosts_a_web_viewer_and_a_grpc_server_while_the_file_is_still_writ
     import socket
     import urllib.request
 
-    from tests.teamrun import ROOT, free_port, wait_for
+    from tests.teamrun import free_port, launched_team, wait_for
 
     web_port, grpc_port = free_port(), free_port()
     out = tmp_path / "run"
-    process = subprocess.Popen(
-        launcher_command(
-            "--n",
-            "4",
-            "--seed",
-            "0",
-            "--out",
-            str(out),
-            "--serve",
-            "--web-port",
-            str(web_port),
-            "--grpc-port",
-            str(grpc_port),
-        ),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    serving = ("--serve", "--web-port", str(web_port), "--grpc-port", str(grpc_port))
 
     def page() -> bytes:
         try:
@@ -141,15 +123,12 @@ def test_serve_hosts_a_web_viewer_and_a_grpc_server_while_the_file_is_still_writ
         except OSError:
             return b""
 
-    try:
+    with launched_team("--n", "4", "--seed", "0", "--out", str(out), *serving) as process:
         assert wait_for(lambda: page() != b"", timeout=120)
         assert b"<html" in page().lower()
         with socket.create_connection(("127.0.0.1", grpc_port), timeout=2):
             pass  # the recording's gRPC server accepts viewers
         stdout, stderr = process.communicate(timeout=400)
-    finally:
-        if process.poll() is None:
-            process.kill()
     assert process.returncode == 0, stderr + stdout
     announced = (out / "logs" / "logger.log").read_text()
     assert f":{web_port}/?url=rerun+http://" in announced and f":{grpc_port}/proxy" in announced

@@ -6,12 +6,11 @@ from __future__ import annotations
 import json
 import os
 import signal
-import subprocess
 import time
 
 import pytest
 
-from tests.teamrun import ROOT, anicov, launcher_command, processes_of, unique_team, wait_for
+from tests.teamrun import anicov, launched_team, processes_of, unique_team, wait_for
 from tests.test_faults import (
     agent_pid,
     agents_started,
@@ -31,23 +30,15 @@ def restarted(out, count: int) -> bool:
 def test_soak_lockstep_paper_run_with_10_percent_loss_and_three_coordinator_kills(tmp_path):
     team = unique_team()
     out = tmp_path / "run"
-    process = subprocess.Popen(
-        launcher_command("--n", "4", "--seed", "1", "--drop-rate", "0.10", "--no-record", "--out", str(out), team=team),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
+    with launched_team(
+        "--n", "4", "--seed", "1", "--drop-rate", "0.10", "--no-record", "--out", str(out), team=team
+    ) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         for kill in range(1, 4):
             time.sleep(3.0)
             os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
             assert wait_for(lambda kill=kill: restarted(out, kill), timeout=120)
         stdout, stderr = process.communicate(timeout=1200)
-    finally:
-        if process.poll() is None:
-            process.kill()
     assert process.returncode == 0, stderr + stdout
     assert "killed and restarted 3 time(s)" in stdout
     engine = anicov("run", "--n", "4", "--seed", "1", "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
@@ -61,38 +52,28 @@ def test_soak_lockstep_paper_run_with_10_percent_loss_and_three_coordinator_kill
 def test_soak_realtime_eight_agents_with_loss_a_dead_agent_and_a_coordinator_kill(tmp_path):
     team = unique_team()
     out = tmp_path / "run"
-    process = subprocess.Popen(
-        launcher_command(
-            "--n",
-            "8",
-            "--seed",
-            "2",
-            "--clock",
-            "realtime",
-            "--speed",
-            "20",
-            "--drop-rate",
-            "0.10",
-            "--no-record",
-            "--out",
-            str(out),
-            team=team,
-        ),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
+    with launched_team(
+        "--n",
+        "8",
+        "--seed",
+        "2",
+        "--clock",
+        "realtime",
+        "--speed",
+        "20",
+        "--drop-rate",
+        "0.10",
+        "--no-record",
+        "--out",
+        str(out),
+        team=team,
+    ) as process:
         assert wait_for(lambda: agents_started(out / "logs", 8), timeout=120)
         time.sleep(3.0)
         os.kill(agent_pid(team, 5), signal.SIGKILL)
         time.sleep(2.0)
         os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
         stdout, stderr = process.communicate(timeout=1200)
-    finally:
-        if process.poll() is None:
-            process.kill()
     assert process.returncode == 0, stderr + stdout
     assert json.loads((out / "summary.json").read_text())["completed"] is True
     coordinator = json.loads((out / "coordinator_counts.json").read_text())

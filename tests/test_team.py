@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import json
 import signal
-import subprocess
 
 import pytest
 
 from tests.teamrun import (
-    ROOT,
     anicov,
+    launched_team,
     launcher_command,
     processes_of,
     run,
@@ -78,14 +77,7 @@ def test_realtime_clock_completes_within_15_percent_of_lockstep(tmp_path):
 @pytest.mark.parametrize(("number", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"])
 def test_signal_stops_every_child_and_exits_with_its_code(tmp_path, number, code):
     team = unique_team()
-    process = subprocess.Popen(
-        launcher_command("--n", "3", "--out", str(tmp_path / "run"), team=team),
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
+    with launched_team("--n", "3", "--out", str(tmp_path / "run"), team=team) as process:
         # Wait until the team is really running: all three agents logged their start.
         logs = tmp_path / "run" / "logs"
         assert wait_for(
@@ -98,9 +90,6 @@ def test_signal_stops_every_child_and_exits_with_its_code(tmp_path, number, code
         assert len(processes_of(team)) >= 4
         process.send_signal(number)
         _, stderr = process.communicate(timeout=60)
-    finally:
-        if process.poll() is None:
-            process.kill()
     assert process.returncode == code, stderr
     assert "every child stopped" in stderr
     assert wait_for(lambda: processes_of(team) == [], timeout=10), processes_of(team)
