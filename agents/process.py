@@ -321,6 +321,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         "duplicates": node.replica.duplicates,
         "applied": node.replica.contiguous(),
         "gaps": sum(len(missing) for missing in node.replica.gaps().values()),
+        "missing": {str(agent): seqs for agent, seqs in node.replica.gaps().items()},  # known lost by everyone
     }
     write_counts(Path(options.counts_file) if options.counts_file else None, counts)
     if node.finished is not None:

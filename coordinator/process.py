@@ -540,6 +540,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             "bytes_sent": node.bytes_sent,
             "duplicates": node.replica.duplicates,
             "gaps": sum(len(v) for v in node.replica.gaps().values()),
+            "missing": {str(agent): seqs for agent, seqs in node.replica.gaps().items()},  # known lost by everyone
             "applied": node.replica.contiguous(),
             "wall_seconds": time.monotonic() - began,
             "events": node.log.events,

@@ -397,7 +397,10 @@ def test_a_dead_agents_lost_deltas_come_from_its_teammates_relays(tmp_path):
     everyone = [coordinator, *survivors]
     assert len({counts["map_digest"] for counts in everyone}) == 1
     assert len({json.dumps(counts["applied"]) for counts in everyone}) == 1  # the same sequences of everyone
-    assert all(counts["gaps"] == 0 for counts in everyone)
+    # A gap may stay only where no survivor received the delta: agent 2's last steps, lost on the way to
+    # every replica while it died (at 10 % loss each, a few in a hundred runs); the same in every replica.
+    assert len({json.dumps(counts["missing"]) for counts in everyone}) == 1
+    assert set(coordinator["missing"]) <= {"2"}
     # At 400 steps a second and 10 % loss, each replica lost tens of agent 2's last steps before its
     # next gap check: the relay path was taken (this fails only if the loss hook is broken).
     assert sum(counts["relayed"] for counts in everyone) > 0
