@@ -29,7 +29,7 @@ import zenoh
 
 from agents.parameters import initial_poses, law_parameters
 from agents.robot import Robot, SimulatedUnicycle
-from agents.step import LawParameters, decide_and_sense
+from agents.step import LawParameters, decide_and_sense, load_kernels
 from anicov.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
 from anicov.scenario import Scenario
 from protocol.bus import (
@@ -47,6 +47,7 @@ from protocol.bus import (
     team_publisher,
     write_counts,
 )
+from protocol.coverage_map import load_kernels as load_map_kernels
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
@@ -168,6 +169,11 @@ class AgentNode:
         self.step += 1
         return delta, state
 
+    def load_kernels(self) -> None:
+        """numba's kernels loaded while the team gathers (see agents.step.load_kernels)."""
+        load_kernels(self.replica.map.coverage, self.robot.pose(), self.law)
+        load_map_kernels()
+
     def hello(self) -> AgentState:
         pose = self.robot.pose()
         return AgentState(self.options.agent, -1, pose, 0.0, 0.0, 0.0, pose)
@@ -259,6 +265,8 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
                 step_publisher.put(encode(node.hello()))
                 next_hello = time.monotonic() + HELLO_PERIOD
                 hellos += 1
+                if hellos == 1:
+                    node.load_kernels()  # while the coordinator waits for the others' hellos
                 if hellos % 5 == 0:
                     recover_go()  # the first go may have been lost
             item = node.inbox.get(timeout=0.05)

@@ -48,6 +48,14 @@ def decide_and_sense(
     return v, omega, e_omega, row0, col0, ticks
 
 
+def load_kernels(coverage: np.ndarray, pose: tuple[float, float, float], law: LawParameters) -> None:
+    """Have numba load the control kernels now, with the argument types of the real calls (half a second
+    from its cache at the first call), on a scratch map: nothing of the agent's state changes."""
+    x, y, theta = pose
+    v, omega, _, _, _, _ = decide_and_sense(np.zeros_like(coverage), x, y, theta, x + 1.0, y, law)
+    move(x, y, theta, v, omega, law)
+
+
 @njit(cache=True)
 def sense_only(
     coverage: np.ndarray, x: float, y: float, theta: float, law: LawParameters

@@ -39,6 +39,7 @@ from protocol.bus import (
     team_publisher,
     write_counts,
 )
+from protocol.coverage_map import load_kernels as load_map_kernels
 from protocol.keys import TeamKeys, agent_of_key
 from protocol.messages import (
     AgentState,
@@ -365,6 +366,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         status_publisher = team_publisher(session, keys.status)
         token = session.liveliness().declare_token(keys.alive("coordinator"))
         settle_garbage_collector()
+        load_map_kernels()  # while the agents start, not in step 0
 
         def publish(publisher: zenoh.Publisher, payload: bytes) -> None:
             node.bytes_sent += len(payload)

@@ -36,6 +36,13 @@ def add_window(coverage: np.ndarray, row0: int, col0: int, ticks: np.ndarray, ta
     return deficit_removed, newly_covered
 
 
+def load_kernels() -> None:
+    """Have numba load this module's compiled kernels now (a quarter of a second from its cache at the
+    first call): a process calls it while the team gathers, so that step 0 does not pay for it."""
+    scratch = np.zeros((1, 1), dtype=np.int64)
+    add_window(scratch, 0, 0, scratch.copy(), 1)
+
+
 class CoverageMap:
     """Λ over a rectangular domain, in fixed-point ticks, with e_D kept up to date."""
 
