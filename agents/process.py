@@ -99,11 +99,14 @@ class AgentNode:
         self.finished: RunControl | None = None
         self.bytes_sent = 0
         self.relay = Relay(self.keys.agent_relay(options.agent))  # realtime: teammates' steps, for when one dies
+        self.teammates: set[int] = set()  # alive, by their liveliness tokens
+        self.teammates_left: list[int] = []
 
     # ------------------------------------------------------------ messages
 
     def handle(self, item: Received | Membership) -> None:
         if isinstance(item, Membership):
+            self.note_teammate(item)
             return
         message = item.message
         if isinstance(message, AgentStep):  # realtime: teammates' deltas, applied as they come
@@ -119,6 +122,22 @@ class AgentNode:
             self.started = True
         elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
             self.finished = message
+
+    def note_teammate(self, change: Membership) -> None:
+        """A teammate's liveliness token came or went. The coordinator replans for the team; a robot
+        logs it (a dead teammate's lost deltas then come from the relays, see protocol.bus.fill_gaps)."""
+        if change.agent == self.options.agent:
+            return
+        if change.alive:
+            if change.agent in self.teammates_left:
+                log.info("agent %d: teammate %d is back", self.options.agent, change.agent)
+            self.teammates.add(change.agent)
+        elif change.agent in self.teammates:
+            self.teammates.discard(change.agent)
+            if self.finished is not None:
+                return  # the run is over: teammates leave as they finish
+            self.teammates_left.append(change.agent)
+            log.warning("agent %d: teammate %d left (its liveliness token is gone)", self.options.agent, change.agent)
 
     def apply_remaining_gos(self) -> None:
         """At the end of a run: the last go completes the map even if the end arrived first."""
@@ -227,6 +246,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             session.declare_subscriber(keys.objectives, node.inbox.on_sample)
             session.declare_queryable(keys.agent_relay(options.agent), node.relay.serve)
         session.declare_subscriber(keys.control, node.inbox.on_sample)
+        session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
         step_publisher = team_publisher(session, keys.agent_step(options.agent))
         token = session.liveliness().declare_token(keys.alive("agent", options.agent))
         settle_garbage_collector()
@@ -329,6 +349,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         "duplicates": node.replica.duplicates,
         "applied": node.replica.contiguous(),
         "gaps": sum(len(missing) for missing in node.replica.gaps().values()),
+        "teammates_left": node.teammates_left,
         "missing": {str(agent): seqs for agent, seqs in node.replica.gaps().items()},  # known lost by everyone
     }
     write_counts(Path(options.counts_file) if options.counts_file else None, counts)
