@@ -96,6 +96,7 @@ class AgentNode:
         self.objective: tuple[float, float] | None = None
         self.started = False  # the coordinator has sent the first go or objectives
         self.gos: dict[int, StepGo] = {}  # lockstep: gos received for steps not yet taken
+        self.last_go = -1  # lockstep: the step of the last go applied
         self.finished: RunControl | None = None
         self.bytes_sent = 0
         self.relay = Relay(self.keys.agent_relay(options.agent))  # realtime: teammates' steps, for when one dies
@@ -157,6 +158,7 @@ class AgentNode:
         go = self.gos.pop(self.step, None)
         if go is None:
             return False
+        self.last_go = go.step
         for delta in go.deltas:
             if delta.agent != self.options.agent:
                 self.replica.apply(delta)
@@ -334,6 +336,13 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
         # Let in-flight deltas of teammates land, so every replica ends with the same map.
         if node.finished is not None:
             node.inbox.drain(0.5, node.handle)
+        final = node.finished.step if node.finished is not None and node.finished.kind == "done" else -1
+        if lockstep and node.last_go < final and final not in node.gos:
+            # The last go (every member's last delta) was lost and the end of the run came first: it is in
+            # the coordinator's history.
+            fetch(session, keys.go_history, node.inbox, first=node.step)
+            while (item := node.inbox.get(timeout=0)) is not None:
+                node.handle(item)
         if node.finished is not None and not lockstep:
             # Realtime: the last deltas of a teammate have no later one to reveal their loss; ask every
             # history for what follows our contiguous run, then stay a moment to answer the others' asks.
