@@ -30,7 +30,7 @@ import zenoh
 from agents.parameters import initial_poses, law_parameters
 from agents.robot import Robot, SimulatedUnicycle
 from agents.step import LawParameters, decide_and_sense, load_kernels
-from anicov.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
+from anicov.lifecycle import EXIT_FAILED, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 from anicov.scenario import Scenario
 from protocol.bus import (
     GAP_CHECK_PERIOD,
@@ -97,6 +97,8 @@ class AgentNode:
         self.started = False  # the coordinator has sent the first go or objectives
         self.gos: dict[int, StepGo] = {}  # lockstep: gos received for steps not yet taken
         self.last_go = -1  # lockstep: the step of the last go applied
+        self.members_seen: set[int] = set()  # lockstep: the members of the last go applied
+        self.rejoining = False  # lockstep: restarted, waiting for a go that lists this agent again
         self.finished: RunControl | None = None
         self.bytes_sent = 0
         self.relay = Relay(self.keys.agent_relay(options.agent))  # realtime: teammates' steps, for when one dies
@@ -159,6 +161,10 @@ class AgentNode:
         if go is None:
             return False
         self.last_go = go.step
+        if self.members_seen:
+            for returning in set(go.members) - self.members_seen:
+                self.replica.skip(returning, go.step - 1)  # the steps it was away will never come
+        self.members_seen = set(go.members)
         for delta in go.deltas:
             if delta.agent != self.options.agent:
                 self.replica.apply(delta)
@@ -169,6 +175,28 @@ class AgentNode:
         if self.objective is None:
             raise RuntimeError(f"agent {self.options.agent} has no objective at step {self.step}")
         return True
+
+    def admitted(self) -> bool:
+        """The team has taken this agent in: any go (or objectives) at the start; after a restart in
+        lockstep, a go that lists it again (the coordinator admits a returning robot at a step boundary)."""
+        if not self.rejoining:
+            return self.started
+        listed = [step for step, go in self.gos.items() if self.options.agent in go.members]
+        if listed:
+            self.join_at(min(listed))
+        return not self.rejoining
+
+    def join_at(self, step: int) -> None:
+        """A returning robot's first go. The gos before it only complete the map (each delta once, over
+        the snapshot); the steps it missed will never come."""
+        for earlier in sorted(s for s in self.gos if s < step):
+            for delta in self.gos.pop(earlier).deltas:
+                if delta.agent != self.options.agent:
+                    self.replica.apply(delta)
+        self.replica.skip(self.options.agent, step - 1)
+        self.members_seen = set(self.gos[step].members)
+        self.step = step
+        self.rejoining = False
 
     def waiting_for(self) -> str:
         """What a lockstep step is waiting on, for the log."""
@@ -272,24 +300,20 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             fetch(session, keys.go_history, node.inbox, first=node.step)
 
         if node.resume_from_snapshot(session):
-            if lockstep:
-                log.error(
-                    "agent %d: a lockstep run cannot be rejoined; restart it with --clock realtime", options.agent
-                )
-                token.undeclare()
-                return EXIT_USAGE
-            log.info("agent %d resumes from the coordinator's snapshot at step %d", options.agent, node.step)
+            # Lockstep: it says hello like a new robot, and the coordinator lists it again from its next go.
+            node.rejoining = lockstep
+            log.info("agent %d resumes from the coordinator's snapshot after step %d", options.agent, node.step - 1)
         # Wait for the first go, saying hello until the coordinator has heard it.
         next_hello = 0.0
         hellos = 0
-        while not node.started and node.finished is None and not stop.stopped:
+        while not node.admitted() and node.finished is None and not stop.stopped:
             if time.monotonic() >= next_hello:
                 step_publisher.put(encode(node.hello()))
                 next_hello = time.monotonic() + HELLO_PERIOD
                 hellos += 1
                 if hellos == 1:
                     node.load_kernels()  # while the coordinator waits for the others' hellos
-                if hellos % 5 == 0:
+                if hellos % 5 == 0 and not node.rejoining:
                     recover_go()  # the first go may have been lost
             item = node.inbox.get(timeout=0.05)
             if item is not None:

@@ -124,6 +124,7 @@ class Coordinator:
         self.closed_states: dict[int, AgentState] = self.states_by_step.get(-1, {})  # the hellos, for go 0
         self.lock = threading.Lock()  # the snapshot queryable reads the replica from Zenoh's thread
         self.relay = Relay(self.keys.coordinator_relay)
+        self.joining: dict[int, tuple[float, float]] = {}  # lockstep: returning robots, admitted at the next go
 
     def snapshot_payload(self) -> bytes:
         """The replica with the last known poses, for a late or restarted process (Zenoh's thread)."""
@@ -162,6 +163,10 @@ class Coordinator:
         elif isinstance(message, MapDelta):
             self._take_delta(message)
         elif isinstance(message, AgentState):  # a hello (step −1), or a state from a history
+            if message.step < 0 and self.open_step and self.members and message.agent not in self.members:
+                # Lockstep, a robot that left comes back (restarted with its id): it joins at the next go.
+                self.joining[message.agent] = (message.next_pose[0], message.next_pose[1])
+                return
             self._take_state(message)
 
     def _take_delta(self, delta: MapDelta) -> None:
@@ -191,6 +196,15 @@ class Coordinator:
         self.closed_states = self.states_by_step.pop(self.open_step, {})
         self.open_deltas = {}
         self.open_step += 1
+        for agent, position in self.joining.items():
+            # It owes its first delta for the step the next go opens; the steps it missed will never come.
+            self.members.add(agent)
+            self.positions[agent] = position
+            self.replica.skip(agent, self.open_step - 1)
+            self.membership_changed = True
+            self.log.events.append(f"agent {agent} rejoined at step {self.open_step}")
+            log.info("agent %d rejoined the team at step %d", agent, self.open_step)
+        self.joining = {}
         waiting = [delta for delta in self.held_back if delta.seq > self.open_step]
         for delta in self.held_back:
             if delta.seq <= self.open_step:

@@ -67,6 +67,16 @@ class MapReplica:
             sequences.add(delta.seq)
             return True
 
+    def skip(self, agent: int, upto: int) -> None:
+        """Sequences of ``agent`` up to ``upto`` will never come: it was away, and a lockstep team
+        readmits it at step ``upto`` + 1. Bookkeeping only: the map is untouched."""
+        with self._lock:
+            sequences = self.applied.setdefault(agent, AppliedSequences())
+            if upto > sequences.contiguous:
+                sequences.extras = {seq for seq in sequences.extras if seq > upto}
+                sequences.contiguous = upto - 1
+                sequences.add(upto)  # merges the extras that follow
+
     def gaps(self) -> dict[int, list[int]]:
         """Known-missing sequences per agent (a later one arrived, these did not)."""
         return {agent: missing for agent, seqs in self.applied.items() if (missing := seqs.gaps())}
