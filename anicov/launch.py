@@ -171,20 +171,16 @@ def wait_for_exit(children: list[Child], timeout: float) -> None:
 
 def warm_numba_cache() -> None:
     """Compile (or load) the jitted kernels once here, so N children do not all compile at once."""
-    import numpy as np
-
     from agents.parameters import law_parameters
-    from agents.step import decide_and_sense, move
+    from agents.step import load_kernels
     from anicov.scenario import Scenario
-    from protocol.coverage_map import CoverageMap, add_window
+    from protocol.coverage_map import CoverageMap
+    from protocol.coverage_map import load_kernels as load_map_kernels
 
     scenario = Scenario()
     grid = CoverageMap(*scenario.grid_shape, scenario.cell, scenario.lambda_star)
-    law = law_parameters(scenario, grid)
-    *_, row0, col0, ticks = decide_and_sense(grid.coverage, 50.0, 50.0, 0.0, 10.0, 10.0, law)
-    add_window(grid.coverage, row0, col0, ticks, law.target_ticks)
-    move(0.0, 0.0, 0.0, 1.0, 0.0, law)
-    np.zeros(1)
+    load_kernels(grid.coverage, (50.0, 50.0, 0.0), law_parameters(scenario, grid))
+    load_map_kernels()
 
 
 def main(argv: list[str] | None = None) -> int:
