@@ -375,16 +375,15 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             node.inbox.drain(0.5, node.handle)
         node.apply_remaining_gos()
         token.undeclare()
-    counts = node.inbox.counts() | {
-        "map_digest": node.replica.digest(),
-        "steps": node.step,
-        "bytes_sent": node.bytes_sent,
-        "duplicates": node.replica.duplicates,
-        "applied": node.replica.contiguous(),
-        "gaps": sum(len(missing) for missing in node.replica.gaps().values()),
-        "teammates_left": node.teammates_left,
-        "missing": {str(agent): seqs for agent, seqs in node.replica.gaps().items()},  # known lost by everyone
-    }
+    counts = (
+        node.inbox.counts()
+        | node.replica.counts()
+        | {
+            "steps": node.step,
+            "bytes_sent": node.bytes_sent,
+            "teammates_left": node.teammates_left,
+        }
+    )
     write_counts(Path(options.counts_file) if options.counts_file else None, counts)
     if node.finished is not None:
         log.info("agent %d: run %s at step %d", options.agent, node.finished.kind, node.finished.step)

@@ -551,17 +551,16 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             fill_gaps(session, keys, node.replica, node.inbox, to_the_end=range(scenario.agents))
             node.inbox.drain(0.5, node.handle)
         token.undeclare()
-        counts = node.inbox.counts() | {
-            "map_digest": node.replica.digest(),
-            "bytes_sent": node.bytes_sent,
-            "duplicates": node.replica.duplicates,
-            "gaps": sum(len(v) for v in node.replica.gaps().values()),
-            "missing": {str(agent): seqs for agent, seqs in node.replica.gaps().items()},  # known lost by everyone
-            "applied": node.replica.contiguous(),
-            "wall_seconds": time.monotonic() - began,
-            "events": node.log.events,
-            "resumed_at": step_resumed,
-        }
+        counts = (
+            node.inbox.counts()
+            | node.replica.counts()
+            | {
+                "bytes_sent": node.bytes_sent,
+                "wall_seconds": time.monotonic() - began,
+                "events": node.log.events,
+                "resumed_at": step_resumed,
+            }
+        )
         if outcome is not None and options.out:
             # Still on the bus while writing: a late logger can fetch the final map's snapshot.
             steps, completed, completion_step = outcome

@@ -272,19 +272,19 @@ def fill_gaps(
     An agent whose history does not answer has died: its teammates' relays
     are asked instead (see :class:`Relay`).
     """
+
+    def from_agent_or_relays(agent: int, first: int = 0, steps: list[int] | None = None) -> int:
+        """Its own history; if that does not answer (it died), its teammates' relays."""
+        return fetch(session, keys.agent_history(agent), inbox, first=first, steps=steps) or fetch(
+            session, keys.all_relays, inbox, first=first, steps=steps, relayed=agent
+        )
+
     asked = 0
     for agent, missing in replica.gaps().items():
-        got = fetch(session, keys.agent_history(agent), inbox, steps=missing)
-        if not got:
-            got = fetch(session, keys.all_relays, inbox, steps=missing, relayed=agent)
-        asked += got
+        asked += from_agent_or_relays(agent, steps=missing)
     for agent in to_the_end:
         applied = replica.applied.get(agent)
-        first = applied.contiguous + 1 if applied else 0
-        got = fetch(session, keys.agent_history(agent), inbox, first=first)
-        if not got:
-            got = fetch(session, keys.all_relays, inbox, first=first, relayed=agent)
-        asked += got
+        asked += from_agent_or_relays(agent, first=applied.contiguous + 1 if applied else 0)
     return asked
 
 

@@ -90,6 +90,17 @@ class MapReplica:
             applied = {agent: (seqs.contiguous, tuple(sorted(seqs.extras))) for agent, seqs in self.applied.items()}
             return Snapshot(self.map.coverage.copy(), applied, dict(poses or {}))
 
+    def counts(self) -> dict[str, object]:
+        """What a process reports of its replica at the end of a run (tests compare them across processes)."""
+        missing = self.gaps()
+        return {
+            "map_digest": self.digest(),
+            "duplicates": self.duplicates,
+            "applied": self.contiguous(),
+            "gaps": sum(len(seqs) for seqs in missing.values()),
+            "missing": {str(agent): seqs for agent, seqs in missing.items()},  # known lost by everyone
+        }
+
     def digest(self) -> str:
         """A short hash of the map, to compare replicas across processes."""
         import hashlib
