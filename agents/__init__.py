@@ -1,3 +1,1 @@
-"""One robot: dynamics, wedge sensing, control law, and the agent process."""
-
-import protocol.numba_cache  # noqa: F401  (before any kernel is compiled)
+"""One robot of the team: the agent process and the ``Robot`` drivers (simulated unicycle)."""

@@ -1,7 +1,7 @@
 """The agent process: one robot of the team, on the bus.
 
 It keeps its own replica of the coverage map, decides (v, ω) with the same
-functions as the in-process engine (:mod:`agents.step`), commands its robot,
+functions as the in-process engine (:mod:`model.step`), commands its robot,
 and publishes its step (coverage delta and state, one message) every step.
 It applies its teammates' deltas and follows the coordinator's objectives.
 
@@ -27,11 +27,11 @@ from pathlib import Path
 
 import zenoh
 
-from agents.parameters import initial_poses, law_parameters
 from agents.robot import Robot, SimulatedUnicycle
-from agents.step import LawParameters, decide_and_sense, load_kernels
-from anicov.lifecycle import EXIT_FAILED, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
-from anicov.scenario import Scenario
+from model.coverage_map import load_kernels as load_map_kernels
+from model.parameters import initial_poses, law_parameters
+from model.scenario import Scenario
+from model.step import LawParameters, decide_and_sense, load_kernels
 from protocol.bus import (
     GAP_CHECK_PERIOD,
     History,
@@ -47,7 +47,6 @@ from protocol.bus import (
     team_publisher,
     write_counts,
 )
-from protocol.coverage_map import load_kernels as load_map_kernels
 from protocol.keys import TeamKeys
 from protocol.messages import (
     AgentState,
@@ -60,6 +59,7 @@ from protocol.messages import (
     encode,
 )
 from protocol.replica import MapReplica
+from runtime.lifecycle import EXIT_FAILED, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 
 log = logging.getLogger("anicov.agent")
 
@@ -219,7 +219,7 @@ class AgentNode:
         return delta, state
 
     def load_kernels(self) -> None:
-        """numba's kernels loaded while the team gathers (see agents.step.load_kernels)."""
+        """numba's kernels loaded while the team gathers (see model.step.load_kernels)."""
         load_kernels(self.replica.map.coverage, self.robot.pose(), self.law)
         load_map_kernels()
 

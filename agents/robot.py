@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from agents.step import LawParameters, move
+from model.step import LawParameters, move
 from protocol.messages import Pose
 
 

@@ -12,8 +12,8 @@ import time
 import uuid
 from pathlib import Path
 
-from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, EXIT_USAGE
-from anicov.scenario import CONTROLLERS, Scenario, ScenarioError, load_scenario
+from model.scenario import CONTROLLERS, Scenario, ScenarioError, load_scenario
+from runtime.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, EXIT_USAGE
 
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "scenarios" / "paper.toml"
 
@@ -28,8 +28,8 @@ def command_run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from anicov.engine import run_scenario
-    from anicov.outputs import format_summary, summary_of, write_summary, write_trajectory
-    from anicov.plots import write_run_plots
+    from runtime.plots import write_run_plots
+    from runtime.rundir import format_summary, summary_of, write_summary, write_trajectory
 
     scenario = resolve_scenario(args)
     out_dir = Path(args.out)
@@ -47,7 +47,7 @@ def command_run(args: argparse.Namespace) -> int:
     write_summary(summary, out_dir / "summary.json")
     write_run_plots(result, out_dir)
     if not args.no_record:
-        from anicov.recording import record_result
+        from logger.recording import record_result
 
         record_result(
             result, out_dir / "recording.rrd", recording_id=f"run-{uuid.uuid4().hex[:12]}", map_every=args.map_every
@@ -70,7 +70,7 @@ def command_replay(args: argparse.Namespace) -> int:
     if not path.is_file():
         raise ScenarioError(f"replay: no recording at {path}")
     if args.summary:
-        from anicov.replay import format_recording_summary, summarise_recording
+        from logger.replay import format_recording_summary, summarise_recording
 
         print(format_recording_summary(summarise_recording(path)))
         return EXIT_OK
@@ -79,9 +79,9 @@ def command_replay(args: argparse.Namespace) -> int:
 
 
 def command_logger(args: argparse.Namespace) -> int:
-    from anicov.lifecycle import StopFlag, setup_logging
-    from anicov.logger import LoggerOptions, run_logger
+    from logger.process import LoggerOptions, run_logger
     from protocol.bus import zenoh_config
+    from runtime.lifecycle import StopFlag, setup_logging
 
     setup_logging("logger", args.verbose)
     if args.nice:
@@ -122,8 +122,8 @@ def _process_scenario(args: argparse.Namespace) -> Scenario:
 
 def command_agent(args: argparse.Namespace) -> int:
     from agents.process import AgentOptions, run_agent
-    from anicov.lifecycle import StopFlag, setup_logging
     from protocol.bus import zenoh_config
+    from runtime.lifecycle import StopFlag, setup_logging
 
     setup_logging(f"agent-{args.id}", args.verbose)
     stop = StopFlag().install()
@@ -136,9 +136,9 @@ def command_agent(args: argparse.Namespace) -> int:
 
 
 def command_coordinator(args: argparse.Namespace) -> int:
-    from anicov.lifecycle import StopFlag, setup_logging
     from coordinator.process import CoordinatorOptions, run_coordinator
     from protocol.bus import zenoh_config
+    from runtime.lifecycle import StopFlag, setup_logging
 
     setup_logging("coordinator", args.verbose)
     stop = StopFlag().install()
@@ -157,8 +157,8 @@ def command_coordinator(args: argparse.Namespace) -> int:
 def command_router(args: argparse.Namespace) -> int:
     import zenoh
 
-    from anicov.lifecycle import StopFlag, setup_logging
     from protocol.bus import zenoh_config
+    from runtime.lifecycle import StopFlag, setup_logging
 
     setup_logging("router")
     stop = StopFlag().install()

@@ -14,51 +14,18 @@ The run ends when no cell is left uncovered (or at ``max_time``).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit
 from numba.typed import List
 
-from agents.parameters import initial_poses, law_parameters
-from agents.step import LawParameters, decide_and_sense, move, sense_only
-from agents.zigzag import WaypointPilot, lane_offsets, split_lanes, zigzag_waypoints
-from anicov.metrics import coverage_distance
-from anicov.scenario import Scenario
-from coordinator.assignment import assign_objectives
-from coordinator.objectives import BlobObjectives, fallback_objective, select_objectives
-from protocol.coverage_map import CoverageMap, add_window
-
-TRACE_FIELDS = ("x", "y", "theta", "v", "omega", "e_omega")
-"""Columns of the per-step trace: pose at the start of the step, then what was applied during it."""
-
-SNAPSHOT_PERIOD = 5.0
-"""Time between stored lack-of-coverage snapshots (for Fig. 6 and the recording)."""
-
-
-@dataclass
-class Planner:
-    """The coordinator's part: Algorithm 1 then Algorithm 2, with objectives kept between calls."""
-
-    scenario: Scenario
-    blobs: BlobObjectives = field(default_factory=BlobObjectives)
-
-    def plan(self, lack: np.ndarray, positions: np.ndarray) -> np.ndarray:
-        """Objective (x, y) for every agent, shape (N, 2)."""
-        self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range)
-        objectives = self.blobs.positions
-        if len(objectives) == 0:
-            fallback = fallback_objective(lack, positions, self.scenario.cell)
-            if fallback is None:
-                return positions.copy()
-            objectives = fallback[None, :]
-        return objectives[assign_objectives(positions, objectives)]
-
-    def record(self, step: int, targets: np.ndarray) -> Plan:
-        """This plan as kept for the recording: members are all agents, in id order."""
-        labels = None if self.blobs.labels is None else self.blobs.labels.astype(np.uint16)
-        return (step, tuple(range(len(targets))), targets.copy(), self.blobs.positions.copy(), labels)
+from model.coverage_map import CoverageMap, add_window
+from model.parameters import initial_poses, law_parameters
+from model.planning import Plan, Planner
+from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack, snapshot_steps
+from model.scenario import Scenario
+from model.step import LawParameters, decide_and_sense, move, sense_only
+from model.zigzag import zigzag_pilots
 
 
 @njit(cache=True)
@@ -109,39 +76,6 @@ def advance_team(
     return steps, uncovered, deficit
 
 
-@dataclass
-class RunResult:
-    """Everything a run produced. ``trace`` has one row per step plus the final poses (v = ω = 0)."""
-
-    scenario: Scenario
-    completed: bool
-    completion_time: float
-    steps: int
-    trace: np.ndarray  # (steps + 1, N, 6), TRACE_FIELDS
-    errors: np.ndarray  # (steps + 1,), e_D at t_0 .. t_steps
-    snapshot_times: list[float]
-    snapshots: list[np.ndarray]  # Υ as uint8 (0 = covered, 255 = untouched)
-    final_lack: np.ndarray
-    plan_time: float | None = None  # zig-zag only: when the last lane was finished
-    plans: list[Plan] = field(default_factory=list)  # every replan, for the recording
-
-    @property
-    def path_lengths(self) -> np.ndarray:
-        """Σ |v| dt per agent (steps whose state was never heard, NaN in a realtime trace, count as 0)."""
-        return np.nansum(np.abs(self.trace[:-1, :, 3]), axis=0) * self.scenario.dt
-
-
-Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
-"""(step, members, targets (N, 2), blob objectives Ψ (M, 2), blob labels of the grid or None)."""
-
-ProgressCallback = Callable[[float, float], None]
-"""Called as progress(sim_time, e_D) after each block of steps."""
-
-
-def _quantised(lack: np.ndarray) -> np.ndarray:
-    return np.round(lack * 255.0).astype(np.uint8)
-
-
 def run_scenario(
     scenario: Scenario,
     poses: np.ndarray | None = None,
@@ -160,7 +94,7 @@ def run_scenario(
     agents = scenario.agents
     traces: list[np.ndarray] = []
     errors: list[np.ndarray] = [np.array([coverage_map.domain_error()])]
-    snapshot_times, snapshots = [0.0], [_quantised(coverage_map.lack_of_coverage())]
+    snapshot_times, snapshots = [0.0], [quantised_lack(coverage_map.lack_of_coverage())]
     scratch_trace = np.zeros((block, agents, len(TRACE_FIELDS)))
     scratch_errors = np.zeros(block)
     steps_done = 0
@@ -192,7 +126,7 @@ def run_scenario(
         now = steps_done * scenario.dt
         if now >= next_snapshot - 1e-9 or coverage_map.complete:
             snapshot_times.append(now)
-            snapshots.append(_quantised(coverage_map.lack_of_coverage()))
+            snapshots.append(quantised_lack(coverage_map.lack_of_coverage()))
             next_snapshot += SNAPSHOT_PERIOD
         if progress is not None:
             progress(now, coverage_map.domain_error())
@@ -241,27 +175,6 @@ def _finish(
     )
 
 
-def zigzag_pilots(scenario: Scenario) -> list[WaypointPilot]:
-    """One waypoint pilot per agent, each sweeping a contiguous block of the Fig. 8 lanes."""
-    d100 = coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
-    d50 = coverage_distance(scenario.lambda_star / 2.0, scenario.range, scenario.half_angle, scenario.alpha_max)
-    lanes = lane_offsets(scenario.domain[1], d100, 2.0 * d50)
-    pilots = []
-    for first, block in split_lanes(lanes, scenario.agents):
-        waypoints = zigzag_waypoints(scenario.domain[0], block, scenario.range, first)
-        pilots.append(WaypointPilot(waypoints, scenario.k_v, scenario.k_omega * math.pi / 2.0, scenario.dt))
-    return pilots
-
-
-def zigzag_start_poses(scenario: Scenario) -> np.ndarray:
-    """Poses at the start of each agent's first lane, facing along it."""
-    poses = []
-    for pilot in zigzag_pilots(scenario):
-        (x0, y0), (x1, y1) = pilot.waypoints[0], pilot.waypoints[1]
-        poses.append((x0, y0, math.atan2(y1 - y0, x1 - x0)))
-    return np.array(poses, dtype=np.float64)
-
-
 def _run_zigzag(
     scenario: Scenario,
     coverage_map: CoverageMap,
@@ -274,7 +187,7 @@ def _run_zigzag(
     pilots = zigzag_pilots(scenario)
     rows_out: list[np.ndarray] = []
     errors = [coverage_map.domain_error()]
-    snapshot_times, snapshots = [0.0], [_quantised(coverage_map.lack_of_coverage())]
+    snapshot_times, snapshots = [0.0], [quantised_lack(coverage_map.lack_of_coverage())]
     completion_step: int | None = None
     step = 0
     while step < scenario.max_steps and not all(pilot.finished for pilot in pilots):
@@ -292,15 +205,15 @@ def _run_zigzag(
         step += 1
         if coverage_map.complete and completion_step is None:
             completion_step = step
-        if step % round(SNAPSHOT_PERIOD / scenario.dt) == 0:
+        if step % snapshot_steps(scenario.dt) == 0:
             snapshot_times.append(step * scenario.dt)
-            snapshots.append(_quantised(coverage_map.lack_of_coverage()))
+            snapshots.append(quantised_lack(coverage_map.lack_of_coverage()))
             if progress is not None:
                 progress(step * scenario.dt, coverage_map.domain_error())
     plan_time = step * scenario.dt if all(pilot.finished for pilot in pilots) else None
     trace = np.stack(rows_out) if rows_out else np.zeros((0, scenario.agents, len(TRACE_FIELDS)))
     snapshot_times.append(step * scenario.dt)
-    snapshots.append(_quantised(coverage_map.lack_of_coverage()))
+    snapshots.append(quantised_lack(coverage_map.lack_of_coverage()))
     chunks = [trace] if record_trace else [np.abs(trace[:, :, 3]).sum(axis=0)[None, :, None]]
     return _finish(
         scenario,

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
-from anicov.lifecycle import (
+from model.scenario import CONTROLLERS, ScenarioError
+from runtime.lifecycle import (
     EXIT_FAILED,
     EXIT_INCOMPLETE,
     EXIT_OK,
@@ -28,7 +29,6 @@ from anicov.lifecycle import (
     StopFlag,
     setup_logging,
 )
-from anicov.scenario import CONTROLLERS, ScenarioError
 
 log = logging.getLogger("anicov.launch")
 
@@ -129,7 +129,7 @@ def child_command(role: str, args: argparse.Namespace, extra: list[str], identit
 
 
 def spawn(role: str, command: list[str], logs: Path) -> Child:
-    from anicov.lifecycle import die_with_parent
+    from runtime.lifecycle import die_with_parent
 
     log_path = logs / f"{role}.log"
     with open(log_path, "wb") as sink:
@@ -171,11 +171,11 @@ def wait_for_exit(children: list[Child], timeout: float) -> None:
 
 def warm_numba_cache() -> None:
     """Compile (or load) the jitted kernels once here, so N children do not all compile at once."""
-    from agents.parameters import law_parameters
-    from agents.step import load_kernels
-    from anicov.scenario import Scenario
-    from protocol.coverage_map import CoverageMap
-    from protocol.coverage_map import load_kernels as load_map_kernels
+    from model.coverage_map import CoverageMap
+    from model.coverage_map import load_kernels as load_map_kernels
+    from model.parameters import law_parameters
+    from model.scenario import Scenario
+    from model.step import load_kernels
 
     scenario = Scenario()
     grid = CoverageMap(*scenario.grid_shape, scenario.cell, scenario.lambda_star)
@@ -315,7 +315,7 @@ def main(argv: list[str] | None = None) -> int:
         return stop.exit_code(EXIT_FAILED)
     summary_path = out_dir / "summary.json"
     if exit_code in (EXIT_OK, EXIT_INCOMPLETE) and summary_path.exists():
-        from anicov.outputs import format_summary
+        from runtime.rundir import format_summary
 
         summary = json.loads(summary_path.read_text())
         print(format_summary(summary, out_dir).replace("anicov run:", f"launch_team ({args.clock}, over Zenoh):"))

@@ -17,9 +17,10 @@ from typing import Any
 
 import numpy as np
 
-from anicov.engine import run_scenario, zigzag_pilots, zigzag_start_poses
-from anicov.metrics import coverage_distance, optimum_time, straight_pass_coverage, total_sensing_ability
-from anicov.scenario import Scenario, ScenarioError, load_scenario
+from anicov.engine import run_scenario
+from model.metrics import coverage_distance, optimum_time, straight_pass_coverage, total_sensing_ability
+from model.scenario import Scenario, ScenarioError, load_scenario
+from model.zigzag import zigzag_pilots, zigzag_start_poses
 
 PAPER = {
     "d100": 2.72,

@@ -16,11 +16,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from anicov.engine import TRACE_FIELDS, advance_team, initial_poses, law_parameters
-from anicov.reference import numpy_team_step
-from anicov.scenario import load_scenario
+from anicov.engine import advance_team
 from bench.machine import describe_machine
-from protocol.coverage_map import CoverageMap
+from model.coverage_map import CoverageMap
+from model.parameters import initial_poses, law_parameters
+from model.reference import numpy_team_step
+from model.run import TRACE_FIELDS
+from model.scenario import load_scenario
 
 PAPER = Path(__file__).resolve().parent.parent / "scenarios" / "paper.toml"
 

@@ -1,0 +1,1 @@
+"""The coordinator process: membership, steps, snapshots, rebuild; its planning is model.planning."""

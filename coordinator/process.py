@@ -21,9 +21,10 @@ from pathlib import Path
 import numpy as np
 import zenoh
 
-from anicov.engine import SNAPSHOT_PERIOD, TRACE_FIELDS, Planner, RunResult
-from anicov.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
-from anicov.scenario import Scenario
+from model.coverage_map import load_kernels as load_map_kernels
+from model.planning import Planner
+from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, RunResult
+from model.scenario import Scenario
 from protocol.bus import (
     GAP_CHECK_PERIOD,
     History,
@@ -39,7 +40,6 @@ from protocol.bus import (
     team_publisher,
     write_counts,
 )
-from protocol.coverage_map import load_kernels as load_map_kernels
 from protocol.keys import TeamKeys, agent_of_key
 from protocol.messages import (
     AgentState,
@@ -53,6 +53,7 @@ from protocol.messages import (
     encode,
 )
 from protocol.replica import MapReplica
+from runtime.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 
 log = logging.getLogger("anicov.coordinator")
 
@@ -597,8 +598,8 @@ def is_running(item: Received | Membership) -> bool:
 
 def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, object]) -> None:
     """trajectory.csv, summary.json and plots, exactly as ``anicov run`` writes them."""
-    from anicov.outputs import summary_of, write_summary, write_trajectory
-    from anicov.plots import write_run_plots
+    from runtime.plots import write_run_plots
+    from runtime.rundir import summary_of, write_summary, write_trajectory
 
     out_dir.mkdir(parents=True, exist_ok=True)
     write_trajectory(result, out_dir / "trajectory.csv")

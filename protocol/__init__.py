@@ -1,3 +1,2 @@
-"""The team protocol: key expressions, validated messages, the replicated coverage map."""
-
-from protocol import numba_cache  # noqa: F401  (before any kernel is compiled)
+"""The team protocol: key expressions, validated messages, the map replica, and the bus helpers
+(sessions, inbox, histories, relays)."""

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from protocol.coverage_map import CoverageMap
+from model.coverage_map import CoverageMap
 from protocol.messages import MapDelta, Snapshot
 
 

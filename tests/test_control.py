@@ -4,7 +4,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from agents.control import combined_law, global_law, local_law
+from model.control import combined_law, global_law, local_law
 
 F = math.radians(27.0)
 unit = st.floats(0.0, 1.0)

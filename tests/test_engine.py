@@ -1,9 +1,10 @@
 import numpy as np
 import pytest
 
-from agents.parameters import initial_poses
-from anicov.engine import TRACE_FIELDS, run_scenario
-from anicov.metrics import optimum_time, total_sensing_ability
+from anicov.engine import run_scenario
+from model.metrics import optimum_time, total_sensing_ability
+from model.parameters import initial_poses
+from model.run import TRACE_FIELDS
 
 
 def test_initial_poses_are_seeded_and_inside_the_domain(paper_scenario):

@@ -273,8 +273,8 @@ def fuzz_a_running_team(tmp_path, domain: list[float], at_least: int, at_most: i
 
 def test_a_late_logger_catches_up_from_the_snapshot_and_records_the_full_final_map(tmp_path):
     from anicov.engine import run_scenario
-    from anicov.replay import summarise_recording
-    from anicov.scenario import load_scenario
+    from logger.replay import summarise_recording
+    from model.scenario import load_scenario
 
     config = write_scenario(tmp_path / "s.toml", domain=[60.0, 60.0], agents=3, seed=4)
     team = unique_team()

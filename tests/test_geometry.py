@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from agents.geometry import wedge_bounds, wedge_cell_range, wrap_angle
+from model.geometry import wedge_bounds, wedge_cell_range, wrap_angle
 
 angles = st.floats(-50.0, 50.0, allow_nan=False)
 

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from anicov.metrics import coverage_distance, optimum_time, straight_pass_coverage, total_sensing_ability
+from model.metrics import coverage_distance, optimum_time, straight_pass_coverage, total_sensing_ability
 
 R, ALPHA = 20.0, 50.0
 F = math.radians(27.0)

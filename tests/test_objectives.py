@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from coordinator.objectives import BlobObjectives, cell_of, fallback_objective, select_objectives
+from model.objectives import BlobObjectives, cell_of, fallback_objective, select_objectives
 
 CELL = 1.0
 R = 20.0

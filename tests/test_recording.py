@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from anicov.engine import run_scenario
-from anicov.replay import summarise_recording
-from anicov.scenario import load_scenario
+from logger.replay import summarise_recording
+from model.scenario import load_scenario
 from tests.teamrun import anicov, launcher_command, run, write_scenario
 
 EXPECTED_ENTITIES = (

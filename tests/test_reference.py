@@ -7,10 +7,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from agents.sensing import sense_wedge
-from agents.step import LawParameters
-from anicov.reference import wedge_readings
-from protocol.fixed_point import COVERAGE_SCALE
+from model.fixed_point import COVERAGE_SCALE
+from model.reference import wedge_readings
+from model.sensing import sense_wedge
+from model.step import LawParameters
 
 LAW = LawParameters(20.0, math.radians(27.0), 50.0, 1.0, 1.0, 1.0, 0.1, 1.0, 100 * COVERAGE_SCALE, False, False)
 CENTRES = np.meshgrid(np.arange(100) + 0.5, np.arange(100) + 0.5)

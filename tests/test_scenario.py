@@ -1,6 +1,6 @@
 import pytest
 
-from anicov.scenario import Scenario, ScenarioError, load_scenario, validate
+from model.scenario import Scenario, ScenarioError, load_scenario, validate
 
 PAPER_KEYS = {
     "domain",

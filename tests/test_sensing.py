@@ -5,9 +5,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from agents.sensing import lack_of_coverage, sense_wedge, sensing_ability
-from anicov.metrics import total_sensing_ability
-from protocol.fixed_point import COVERAGE_SCALE
+from model.fixed_point import COVERAGE_SCALE
+from model.metrics import total_sensing_ability
+from model.sensing import lack_of_coverage, sense_wedge, sensing_ability
 
 R, F, ALPHA = 20.0, math.radians(27.0), 50.0
 TARGET = 100 * COVERAGE_SCALE

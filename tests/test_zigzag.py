@@ -3,8 +3,8 @@ import math
 import numpy as np
 import pytest
 
-from agents.zigzag import WaypointPilot, lane_offsets, split_lanes, zigzag_waypoints
-from anicov.engine import run_scenario, zigzag_start_poses
+from anicov.engine import run_scenario
+from model.zigzag import WaypointPilot, lane_offsets, split_lanes, zigzag_start_poses, zigzag_waypoints
 
 
 def test_paper_lanes_fig8():

@@ -15,13 +15,13 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 KERNEL_SOURCES = (
-    "agents/geometry.py",
-    "agents/sensing.py",
-    "agents/control.py",
-    "agents/dynamics.py",
-    "agents/step.py",
-    "protocol/fixed_point.py",
-    "protocol/coverage_map.py",
+    "model/geometry.py",
+    "model/sensing.py",
+    "model/control.py",
+    "model/dynamics.py",
+    "model/step.py",
+    "model/fixed_point.py",
+    "model/coverage_map.py",
     "anicov/engine.py",
 )
 

@@ -10,8 +10,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from anicov.engine import RunResult
-from anicov.metrics import optimum_time, total_sensing_ability
+from model.metrics import optimum_time, total_sensing_ability
+from model.run import RunResult
 
 TRAJECTORY_HEADER = "t,agent,x,y,theta,v,omega"
 

@@ -11,9 +11,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from agents.control import combined_law, global_law, local_law
-from agents.dynamics import unicycle_step
-from agents.sensing import sense_wedge
+from model.control import combined_law, global_law, local_law
+from model.dynamics import unicycle_step
+from model.sensing import sense_wedge
 
 
 class LawParameters(NamedTuple):

@@ -9,9 +9,9 @@ import math
 
 import numpy as np
 
-from agents.step import LawParameters
-from anicov.scenario import Scenario
-from protocol.coverage_map import CoverageMap
+from model.coverage_map import CoverageMap
+from model.scenario import Scenario
+from model.step import LawParameters
 
 
 def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParameters:

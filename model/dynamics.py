@@ -6,7 +6,7 @@ import math
 
 from numba import njit
 
-from agents.geometry import wrap_angle
+from model.geometry import wrap_angle
 
 
 @njit(cache=True)

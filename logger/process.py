@@ -17,9 +17,8 @@ from pathlib import Path
 import numpy as np
 import zenoh
 
-from anicov.lifecycle import EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
-from anicov.recording import RunRecorder
-from anicov.scenario import Scenario
+from logger.recording import RunRecorder
+from model.scenario import Scenario
 from protocol.bus import Inbox, Membership, Received, fetch, fetch_snapshot, open_session, write_counts
 from protocol.keys import TeamKeys
 from protocol.messages import (
@@ -31,8 +30,9 @@ from protocol.messages import (
     StepGo,
 )
 from protocol.replica import MapReplica
+from runtime.lifecycle import EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 
-log = logging.getLogger("anicov.logger")
+log = logging.getLogger("logger.process")
 
 FLUSH_PERIOD = 0.5
 """Seconds between sends of the buffered per-step columns."""

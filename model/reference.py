@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from agents.control import combined_law, global_law, local_law
-from agents.dynamics import unicycle_step
-from agents.step import LawParameters
-from protocol.fixed_point import COVERAGE_SCALE
+from model.control import combined_law, global_law, local_law
+from model.dynamics import unicycle_step
+from model.fixed_point import COVERAGE_SCALE
+from model.step import LawParameters
 
 
 def wedge_readings(

@@ -1,6 +1,6 @@
 """The coverage map Λ (eq. 3) as a grid of fixed-point cells.
 
-Every cell is a grow-only counter of integer ticks (:mod:`protocol.fixed_point`):
+Every cell is a grow-only counter of integer ticks (:mod:`model.fixed_point`):
 adding deltas commutes exactly, so replicas that applied the same deltas agree
 bit for bit whatever the order. The map also keeps, exactly and
 incrementally, the number of cells still uncovered and the summed deficit
@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from protocol.fixed_point import COVERAGE_SCALE
+from model.fixed_point import COVERAGE_SCALE
 
 
 @njit(cache=True)

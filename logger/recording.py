@@ -34,7 +34,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from anicov.scenario import Scenario
+from model.scenario import Scenario
 
 APPLICATION_ID = "anicov"
 TRAIL_STEPS = 500

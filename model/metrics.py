@@ -7,7 +7,7 @@ import math
 
 from scipy import integrate, optimize
 
-from agents.sensing import sensing_ability
+from model.sensing import sensing_ability
 
 
 def total_sensing_ability(sensing_range: float, half_angle: float, alpha_max: float) -> float:

@@ -2,7 +2,7 @@
 
 The map is a grid of cells of side ``cell``; cell (row, col) has its centre at
 ((col + ½)·cell, (row + ½)·cell). Coverage is held in fixed-point ticks
-(:mod:`protocol.fixed_point`) so deltas from different agents commute exactly.
+(:mod:`model.fixed_point`) so deltas from different agents commute exactly.
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ import math
 import numpy as np
 from numba import njit
 
-from agents.geometry import wedge_cell_range
-from protocol.fixed_point import COVERAGE_SCALE
+from model.fixed_point import COVERAGE_SCALE
+from model.geometry import wedge_cell_range
 
 
 @njit(cache=True)

@@ -16,7 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from agents.geometry import wrap_angle
+from model.geometry import wrap_angle
+from model.metrics import coverage_distance
+from model.scenario import Scenario
 
 HEADING_TOLERANCE = 1e-6
 """Below this heading error (rad) the pilot drives instead of turning."""
@@ -77,3 +79,24 @@ class WaypointPilot:
                 return 0.0, math.copysign(turn, heading_error)
             return min(self.k_v, distance / self.dt), heading_error / self.dt
         return 0.0, 0.0
+
+
+def zigzag_pilots(scenario: Scenario) -> list[WaypointPilot]:
+    """One waypoint pilot per agent, each sweeping a contiguous block of the Fig. 8 lanes."""
+    d100 = coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
+    d50 = coverage_distance(scenario.lambda_star / 2.0, scenario.range, scenario.half_angle, scenario.alpha_max)
+    lanes = lane_offsets(scenario.domain[1], d100, 2.0 * d50)
+    pilots = []
+    for first, block in split_lanes(lanes, scenario.agents):
+        waypoints = zigzag_waypoints(scenario.domain[0], block, scenario.range, first)
+        pilots.append(WaypointPilot(waypoints, scenario.k_v, scenario.k_omega * math.pi / 2.0, scenario.dt))
+    return pilots
+
+
+def zigzag_start_poses(scenario: Scenario) -> np.ndarray:
+    """Poses at the start of each agent's first lane, facing along it."""
+    poses = []
+    for pilot in zigzag_pilots(scenario):
+        (x0, y0), (x1, y1) = pilot.waypoints[0], pilot.waypoints[1]
+        poses.append((x0, y0, math.atan2(y1 - y0, x1 - x0)))
+    return np.array(poses, dtype=np.float64)

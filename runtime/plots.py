@@ -10,7 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from anicov.engine import RunResult
+from model.run import RunResult
 
 
 def plot_domain_error(result: RunResult, path: Path) -> None:
