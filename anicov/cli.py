@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import logging
-import os
 import shutil
 import subprocess
 import sys
@@ -12,16 +10,12 @@ import time
 import uuid
 from pathlib import Path
 
-from model.scenario import CONTROLLERS, Scenario, ScenarioError, load_scenario
+from agents import command as agent_command
+from coordinator import command as coordinator_command
+from logger import command as logger_command
+from model.scenario import ScenarioError
+from runtime.arguments import add_scenario_arguments, scenario_from_arguments
 from runtime.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, EXIT_USAGE
-
-DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "scenarios" / "paper.toml"
-
-
-def resolve_scenario(args: argparse.Namespace) -> Scenario:
-    """The scenario file (or the paper's) with command-line overrides applied."""
-    scenario = load_scenario(args.config) if args.config else load_scenario(DEFAULT_CONFIG)
-    return scenario.with_overrides(agents=args.n, seed=args.seed, controller=args.controller)
 
 
 def command_run(args: argparse.Namespace) -> int:
@@ -31,7 +25,7 @@ def command_run(args: argparse.Namespace) -> int:
     from runtime.plots import write_run_plots
     from runtime.rundir import format_summary, summary_of, write_summary, write_trajectory
 
-    scenario = resolve_scenario(args)
+    scenario = scenario_from_arguments(args)
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
@@ -78,33 +72,6 @@ def command_replay(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def command_logger(args: argparse.Namespace) -> int:
-    from logger.process import LoggerOptions, run_logger
-    from protocol.bus import zenoh_config
-    from runtime.lifecycle import StopFlag, setup_logging
-
-    setup_logging("logger", args.verbose)
-    if args.nice:
-        # The logger is off the team's critical path: let the robots' processes have the CPU first.
-        os.nice(args.nice)
-    stop = StopFlag().install()
-    scenario = _process_scenario(args)
-    options = LoggerOptions(
-        args.team,
-        args.recording_id or f"{args.team}-{uuid.uuid4().hex[:12]}",
-        None if args.no_record else args.out,
-        args.viewer,
-        args.serve,
-        args.map_every,
-        args.counts,
-        args.clock,
-        args.web_port,
-        args.grpc_port,
-    )
-    config = zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
-    return run_logger(scenario, options, config, stop)
-
-
 def command_reproduce(args: argparse.Namespace) -> int:
     from anicov.reproduce import parse_team_range, reproduce
 
@@ -113,51 +80,10 @@ def command_reproduce(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _process_scenario(args: argparse.Namespace) -> Scenario:
-    scenario = resolve_scenario(args)
-    if args.speed <= 0:
-        raise ScenarioError(f"--speed: expected a positive number, got {args.speed}")
-    return scenario
-
-
-def command_agent(args: argparse.Namespace) -> int:
-    from agents.process import AgentOptions, run_agent
-    from protocol.bus import zenoh_config
-    from runtime.lifecycle import StopFlag, setup_logging
-
-    setup_logging(f"agent-{args.id}", args.verbose)
-    stop = StopFlag().install()
-    scenario = _process_scenario(args)
-    if not 0 <= args.id < scenario.agents:
-        raise ScenarioError(f"--id: expected an agent id from 0 to {scenario.agents - 1}, got {args.id}")
-    options = AgentOptions(args.team, args.id, args.clock, args.speed, args.drop_rate, args.counts)
-    config = zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
-    return run_agent(scenario, options, config, stop)
-
-
-def command_coordinator(args: argparse.Namespace) -> int:
-    from coordinator.process import CoordinatorOptions, run_coordinator
-    from protocol.bus import zenoh_config
-    from runtime.lifecycle import StopFlag, setup_logging
-
-    setup_logging("coordinator", args.verbose)
-    stop = StopFlag().install()
-    scenario = _process_scenario(args)
-    options = CoordinatorOptions(args.team, args.clock, args.speed, args.out, args.drop_rate, args.await_logger)
-    config = zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
-    code = run_coordinator(scenario, options, config, stop)
-    # Its session is closed and its files are written: skip the interpreter's teardown of numba,
-    # matplotlib and friends (half a second), which the whole team's launcher would wait for.
-    logging.shutdown()
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)
-
-
 def command_router(args: argparse.Namespace) -> int:
     import zenoh
 
-    from protocol.bus import zenoh_config
+    from protocol.session import zenoh_config
     from runtime.lifecycle import StopFlag, setup_logging
 
     setup_logging("router")
@@ -194,30 +120,30 @@ def command_launch(args: argparse.Namespace) -> int:
     return launch_main(args.rest)
 
 
-def _add_process_arguments(parser: argparse.ArgumentParser) -> None:
-    from anicov.launch import add_team_arguments
-
-    add_team_arguments(parser)
-    parser.add_argument("--team", default="team", help="team name: keys live under anicov/<team>/")
-    parser.add_argument(
-        "--connect", action="append", help="Zenoh endpoint to connect to (repeatable), e.g. tcp/192.168.1.10:7447"
-    )
-    parser.add_argument("--listen", action="append", help="Zenoh endpoint to listen on (peer mode)")
-    parser.add_argument("--mode", choices=("client", "peer"), default="client", help="Zenoh mode (default client)")
-    parser.add_argument("--zenoh-config", help="a Zenoh JSON5 config file (see deploy/); flags add endpoints")
-    parser.add_argument("--drop-rate", type=float, default=0.0, help=argparse.SUPPRESS)  # test hook
-    parser.add_argument("--verbose", action="store_true", help="debug logging")
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="anicov", description=__doc__)
     commands = parser.add_subparsers(dest="command", required=True)
+    _add_in_process_commands(commands)
+    # The team's processes: each part declares its own arguments (agents/, coordinator/, logger/ command.py).
+    for name, part, text in (
+        ("agent", agent_command, "one robot of a team, on the Zenoh bus"),
+        ("coordinator", coordinator_command, "the team's coordinator (Algorithms 1-2), on the bus"),
+        ("logger", logger_command, "record a team over the bus into a rerun recording"),
+    ):
+        command = commands.add_parser(name, help=text)
+        part.add_arguments(command)
+        command.set_defaults(handler=part.main)
+    _add_bus_tools(commands)
+    launch = commands.add_parser("launch", help="a whole team on this machine (same as launch_team.py)", add_help=False)
+    launch.add_argument("rest", nargs=argparse.REMAINDER)
+    launch.set_defaults(handler=command_launch)
+    return parser
 
+
+def _add_in_process_commands(commands: argparse._SubParsersAction) -> None:
+    """run, replay, reproduce: work done in this process."""
     run = commands.add_parser("run", help="run one team in this process and write its outputs")
-    run.add_argument("--config", help="scenario TOML (default: scenarios/paper.toml)")
-    run.add_argument("--n", type=int, help="team size (overrides 'agents')")
-    run.add_argument("--seed", type=int, help="seed of the initial poses (overrides 'seed')")
-    run.add_argument("--controller", choices=CONTROLLERS, help="overrides 'controller'")
+    add_scenario_arguments(run)
     run.add_argument("--out", required=True, help="output directory")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     run.add_argument("--no-record", action="store_true", help="do not write OUT/recording.rrd")
@@ -230,22 +156,6 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_argument("--summary", action="store_true", help="print what it holds, headless")
     replay.set_defaults(handler=command_replay)
 
-    logger = commands.add_parser("logger", help="record a team over the bus into a rerun recording")
-    logger.add_argument("--out", default="recording.rrd", help="recording file (default recording.rrd)")
-    logger.add_argument("--recording-id", help="share one recording id with other loggers of the run")
-    logger.add_argument("--no-record", action="store_true", help="no file (only a live viewer)")
-    logger.add_argument("--viewer", action="store_true", help="spawn a live rerun viewer")
-    logger.add_argument("--serve", action="store_true", help="serve a web viewer for a remote browser")
-    logger.add_argument("--web-port", type=int, default=9090, help="--serve: HTTP port of the web viewer")
-    logger.add_argument("--grpc-port", type=int, default=9876, help="--serve: port of the recording's gRPC server")
-    logger.add_argument("--map-every", type=int, default=50, help="log the map every K steps (default 50)")
-    logger.add_argument("--counts", help="write message counters to this JSON file at exit")
-    logger.add_argument(
-        "--nice", type=int, default=0, help="lower this process's CPU priority by this much (default 0)"
-    )
-    _add_process_arguments(logger)
-    logger.set_defaults(handler=command_logger)
-
     reproduce = commands.add_parser("reproduce", help="the paper's experiments (Fig. 7–10) with a table and plots")
     reproduce.add_argument("--out", required=True, help="output directory")
     reproduce.add_argument("--runs", type=int, default=100, help="runs per team size (default 100)")
@@ -254,20 +164,9 @@ def build_parser() -> argparse.ArgumentParser:
     reproduce.add_argument("--seed", type=int, default=0, help="base seed; run r of every team uses seed+r")
     reproduce.set_defaults(handler=command_reproduce)
 
-    agent = commands.add_parser("agent", help="one robot of a team, on the Zenoh bus")
-    agent.add_argument("--id", type=int, required=True, help="this agent's id, 0..N-1")
-    agent.add_argument("--counts", help="write message counters to this JSON file at exit")
-    _add_process_arguments(agent)
-    agent.set_defaults(handler=command_agent)
 
-    coordinator = commands.add_parser("coordinator", help="the team's coordinator (Algorithms 1-2), on the bus")
-    coordinator.add_argument("--out", help="write the run directory here at the end")
-    coordinator.add_argument(
-        "--await-logger", action="store_true", help="start the run only once a logger is listening"
-    )
-    _add_process_arguments(coordinator)
-    coordinator.set_defaults(handler=command_coordinator)
-
+def _add_bus_tools(commands: argparse._SubParsersAction) -> None:
+    """router, certs: what a team spread over hosts needs besides its processes."""
     router = commands.add_parser("router", help="a standalone Zenoh router for a team spread over hosts")
     router.add_argument("--listen", action="append", help="endpoint (repeatable), e.g. tcp/0.0.0.0:7447")
     router.add_argument("--zenoh-config", help="a Zenoh JSON5 config file (see deploy/router.json5)")
@@ -288,11 +187,6 @@ def build_parser() -> argparse.ArgumentParser:
     certs.add_argument("--days", type=int, default=365, help="validity in days (default 365)")
     certs.set_defaults(handler=command_certs)
 
-    launch = commands.add_parser("launch", help="a whole team on this machine (same as launch_team.py)", add_help=False)
-    launch.add_argument("rest", nargs=argparse.REMAINDER)
-    launch.set_defaults(handler=command_launch)
-    return parser
-
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
@@ -302,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
     except (ScenarioError, ValueError) as error:
         print(f"anicov: error: {error}", file=sys.stderr)
         return EXIT_USAGE
-    except RuntimeError as error:  # e.g. protocol.bus.RouterUnreachable: say what, not a traceback
+    except RuntimeError as error:  # e.g. protocol.session.RouterUnreachable: say what, not a traceback
         print(f"anicov: error: {error}", file=sys.stderr)
         return EXIT_FAILED
     except KeyboardInterrupt:

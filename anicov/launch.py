@@ -16,11 +16,13 @@ import logging
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from model.scenario import CONTROLLERS, ScenarioError
+from model.scenario import Scenario
+from runtime.arguments import add_team_arguments, scenario_from_arguments
 from runtime.lifecycle import (
     EXIT_FAILED,
     EXIT_INCOMPLETE,
@@ -29,6 +31,11 @@ from runtime.lifecycle import (
     StopFlag,
     setup_logging,
 )
+
+if TYPE_CHECKING:
+    import zenoh
+
+    from protocol.messages import RunControl
 
 log = logging.getLogger("anicov.launch")
 
@@ -45,25 +52,6 @@ class Child:
     role: str
     process: subprocess.Popen[bytes]
     log_path: Path
-
-
-def add_team_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--n", type=int, help="team size (overrides the scenario's 'agents'; the paper's is 4)")
-    parser.add_argument("--config", help="scenario TOML (default: scenarios/paper.toml)")
-    parser.add_argument("--seed", type=int, help="seed of the initial poses")
-    parser.add_argument("--controller", choices=[c for c in CONTROLLERS if c != "zigzag"], help="control law")
-    parser.add_argument(
-        "--clock",
-        choices=("lockstep", "realtime"),
-        default="lockstep",
-        help="lockstep: deterministic, equal to 'anicov run'; realtime: wall-clock steps",
-    )
-    parser.add_argument(
-        "--speed",
-        type=float,
-        default=10.0,
-        help="realtime only: simulated time units per wall-clock second (default 10)",
-    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -183,129 +171,71 @@ def warm_numba_cache() -> None:
     load_map_kernels()
 
 
+@dataclass
+class Supervision:
+    """What the launcher saw while the team ran: the coordinator's exit code, robots lost, restarts."""
+
+    exit_code: int = EXIT_FAILED
+    lost: list[str] = field(default_factory=list)
+    restarts: int = 0
+
+
+class ControlWatch:
+    """The run's control and status messages, read on the router's session (decoded, validated)."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        from protocol.messages import Limits
+
+        self.limits = Limits(*scenario.grid_shape, scenario.agents)
+        self.latest: dict[str, RunControl] = {}
+
+    def on_sample(self, sample: zenoh.Sample) -> None:
+        from protocol.decoding import decode
+        from protocol.messages import ProtocolError, RunControl
+
+        try:
+            message = decode(sample.payload.to_bytes(), self.limits, expected="control")
+        except ProtocolError:
+            return
+        assert isinstance(message, RunControl)
+        self.latest["done" if message.kind in ("done", "abort") else "status"] = message
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     setup_logging("launch")
     stop = StopFlag().install()
-    from anicov.cli import resolve_scenario
-
     try:
-        scenario = resolve_scenario(args)
-        if args.speed <= 0:
-            raise ScenarioError(f"--speed: expected a positive number, got {args.speed}")
-    except ScenarioError as error:
+        scenario = scenario_from_arguments(args)
+        router_config_file = apply_secure_profile(args, scenario.agents)
+    except ValueError as error:  # ScenarioError, or a --secure profile that does not fit
         print(f"launch_team: error: {error}", file=sys.stderr)
         return EXIT_USAGE
-    router_config_file = None
-    if args.secure:
-        from anicov.secure import load_profile
-
-        try:
-            profile, endpoint = load_profile(Path(args.secure), args.team, scenario.agents)
-        except ValueError as error:
-            print(f"launch_team: error: {error}", file=sys.stderr)
-            return EXIT_USAGE
-        router_config_file = str(profile.config("router"))
-        args.bus = "client"  # the profile's certificates and access control are the router's
-        args.listen = args.listen or endpoint
-    args.listen = args.listen or "tcp/127.0.0.1:7447"
     out_dir = Path(args.out or Path("runs") / datetime.now().strftime("%Y%m%d-%H%M%S"))
-    out_dir.mkdir(parents=True, exist_ok=True)
     logs = out_dir / "logs"
-    logs.mkdir(exist_ok=True)
+    logs.mkdir(parents=True, exist_ok=True)
     warm_numba_cache()
 
     import zenoh
-    from tqdm import tqdm
 
-    from protocol.bus import zenoh_config
     from protocol.keys import TeamKeys
-    from protocol.messages import Limits, ProtocolError, RunControl, decode
-
-    keys = TeamKeys(args.team)
-    limits = Limits(*scenario.grid_shape, scenario.agents)
-    latest: dict[str, RunControl] = {}
-
-    def on_control(sample: zenoh.Sample) -> None:
-        try:
-            message = decode(sample.payload.to_bytes(), limits, expected="control")
-        except ProtocolError:
-            return
-        assert isinstance(message, RunControl)
-        latest["done" if message.kind in ("done", "abort") else "status"] = message
+    from protocol.session import zenoh_config
 
     started = time.monotonic()
-    children: list[Child] = []
-    exit_code = EXIT_FAILED
     try:
         router = zenoh.open(zenoh_config("router", listen=[args.listen], config_file=router_config_file))
     except zenoh.ZError as error:
         print(f"launch_team: error: cannot open the router on {args.listen}: {error}", file=sys.stderr)
         return EXIT_USAGE
+    children: list[Child] = []
     with router:
-        router.declare_subscriber(keys.control, on_control)
-        router.declare_subscriber(keys.status, on_control)
-        recording = not args.no_record or args.viewer or args.serve
-        # All children start at once; the coordinator starts the run when every agent has said hello
-        # and, when recording, the logger listens (so the recording holds every step).
-        coordinator_command = child_command(
-            "coordinator", args, ["--out", str(out_dir)] + ["--await-logger"] * bool(recording)
-        )
-        children.append(spawn("coordinator", coordinator_command, logs))
-        if recording:
-            logger_flags = [
-                "--out",
-                str(out_dir / "recording.rrd"),
-                "--map-every",
-                str(args.map_every),
-                "--recording-id",
-                f"{args.team}-{out_dir.name}",
-            ]
-            logger_flags += ["--counts", str(logs / "logger.counts.json"), "--nice", str(LOGGER_NICE)]
-            logger_flags += ["--no-record"] * args.no_record + ["--viewer"] * args.viewer
-            if args.serve:
-                logger_flags += ["--serve", "--web-port", str(args.web_port), "--grpc-port", str(args.grpc_port)]
-            children.append(spawn("logger", child_command("logger", args, logger_flags), logs))
-        for agent in range(scenario.agents):
-            agent_flags = ["--id", str(agent), "--counts", str(logs / f"agent-{agent}.counts.json")]
-            name = f"agent-{agent}"
-            children.append(spawn(name, child_command("agent", args, agent_flags, identity=name), logs))
-        bar = tqdm(total=100, desc=f"team of {scenario.agents}", unit="%", disable=args.quiet or None)
-        coordinator = children[0]
-        reported: set[str] = set()
-        lost: list[str] = []
-        restarts = 0
+        keys, watch = TeamKeys(args.team), ControlWatch(scenario)
+        router.declare_subscriber(keys.control, watch.on_sample)
+        router.declare_subscriber(keys.status, watch.on_sample)
+        coordinator_command = start_team(args, scenario.agents, out_dir, children)
         try:
-            while not stop.stopped:
-                status = latest.get("status")
-                if status is not None:
-                    bar.set_postfix_str(f"t={status.step * scenario.dt:.0f}", refresh=False)
-                    bar.update(max(0, round(100 * (1 - status.domain_error)) - bar.n))
-                code = coordinator.process.poll()
-                if code is not None and code < 0 and restarts < COORDINATOR_RESTARTS:
-                    # Killed, not finished: a new coordinator rebuilds the run from the agents' histories.
-                    restarts += 1
-                    log.warning("the coordinator was killed (signal %d); starting it again (%d)", -code, restarts)
-                    coordinator = spawn(f"coordinator.restart-{restarts}", coordinator_command, logs)
-                    children[0] = coordinator
-                    continue
-                if code is not None:
-                    exit_code = code
-                    break
-                # A robot that dies is the team's problem, not the run's: the coordinator notices it
-                # through liveliness and carries on without it. Only report it.
-                for child in children[1:]:
-                    code = child.process.poll()
-                    if code is not None and child.role not in reported:
-                        reported.add(child.role)
-                        if code != 0 and "done" not in latest:
-                            log.warning(
-                                "%s exited with %s; the team carries on (see %s)", child.role, code, child.log_path
-                            )
-                            lost.append(child.role)
-                stop.wait(0.1)
+            seen = supervise(children, coordinator_command, logs, watch, scenario, args.quiet, stop)
         finally:
-            bar.close()
             if not stop.stopped:
                 # After the end of the run every child leaves by itself (the logger flushes first).
                 wait_for_exit(children, GRACE_SECONDS)
@@ -313,26 +243,121 @@ def main(argv: list[str] | None = None) -> int:
     if stop.stopped:
         print(f"launch_team: stopped by signal; every child stopped. Logs in {logs}", file=sys.stderr)
         return stop.exit_code(EXIT_FAILED)
+    return report(args, scenario.agents, out_dir, children, seen, time.monotonic() - started)
+
+
+def apply_secure_profile(args: argparse.Namespace, agents: int) -> str | None:
+    """With --secure: the router's config file, and the profile's endpoint and client bus; else None."""
+    router_config_file = None
+    if args.secure:
+        from anicov.secure import load_profile
+
+        profile, endpoint = load_profile(Path(args.secure), args.team, agents)
+        router_config_file = str(profile.config("router"))
+        args.bus = "client"  # the profile's certificates and access control are the router's
+        args.listen = args.listen or endpoint
+    args.listen = args.listen or "tcp/127.0.0.1:7447"
+    return router_config_file
+
+
+def start_team(args: argparse.Namespace, agents: int, out_dir: Path, children: list[Child]) -> list[str]:
+    """Spawn the coordinator, the logger (when recording) and the agents; return the coordinator's
+    command line (a killed coordinator is started again with it).
+
+    All children start at once; the coordinator starts the run when every agent has said hello and,
+    when recording, the logger listens (so the recording holds every step).
+    """
+    logs = out_dir / "logs"
+    recording = not args.no_record or args.viewer or args.serve
+    coordinator_command = child_command(
+        "coordinator", args, ["--out", str(out_dir)] + ["--await-logger"] * bool(recording)
+    )
+    children.append(spawn("coordinator", coordinator_command, logs))
+    if recording:
+        logger_flags = ["--out", str(out_dir / "recording.rrd"), "--map-every", str(args.map_every)]
+        logger_flags += ["--recording-id", f"{args.team}-{out_dir.name}"]
+        logger_flags += ["--counts", str(logs / "logger.counts.json"), "--nice", str(LOGGER_NICE)]
+        logger_flags += ["--no-record"] * args.no_record + ["--viewer"] * args.viewer
+        if args.serve:
+            logger_flags += ["--serve", "--web-port", str(args.web_port), "--grpc-port", str(args.grpc_port)]
+        children.append(spawn("logger", child_command("logger", args, logger_flags), logs))
+    for agent in range(agents):
+        agent_flags = ["--id", str(agent), "--counts", str(logs / f"agent-{agent}.counts.json")]
+        name = f"agent-{agent}"
+        children.append(spawn(name, child_command("agent", args, agent_flags, identity=name), logs))
+    return coordinator_command
+
+
+def supervise(
+    children: list[Child],
+    coordinator_command: list[str],
+    logs: Path,
+    watch: ControlWatch,
+    scenario: Scenario,
+    quiet: bool,
+    stop: StopFlag,
+) -> Supervision:
+    """Show progress until the coordinator exits; restart a killed coordinator; report lost robots."""
+    from tqdm import tqdm
+
+    seen = Supervision()
+    reported: set[str] = set()
+    with tqdm(total=100, desc=f"team of {scenario.agents}", unit="%", disable=quiet or None) as bar:
+        while not stop.stopped:
+            status = watch.latest.get("status")
+            if status is not None:
+                bar.set_postfix_str(f"t={status.step * scenario.dt:.0f}", refresh=False)
+                bar.update(max(0, round(100 * (1 - status.domain_error)) - bar.n))
+            code = children[0].process.poll()
+            if code is not None and code < 0 and seen.restarts < COORDINATOR_RESTARTS:
+                # Killed, not finished: a new coordinator rebuilds the run from the agents' histories.
+                seen.restarts += 1
+                log.warning("the coordinator was killed (signal %d); starting it again (%d)", -code, seen.restarts)
+                children[0] = spawn(f"coordinator.restart-{seen.restarts}", coordinator_command, logs)
+                continue
+            if code is not None:
+                seen.exit_code = code
+                break
+            # A robot that dies is the team's problem, not the run's: the coordinator notices it
+            # through liveliness and carries on without it. Only report it.
+            for child in children[1:]:
+                code = child.process.poll()
+                if code is not None and child.role not in reported:
+                    reported.add(child.role)
+                    if code != 0 and "done" not in watch.latest:
+                        log.warning("%s exited with %s; the team carries on (see %s)", child.role, code, child.log_path)
+                        seen.lost.append(child.role)
+            stop.wait(0.1)
+    return seen
+
+
+def report(
+    args: argparse.Namespace, agents: int, out_dir: Path, children: list[Child], seen: Supervision, wall: float
+) -> int:
+    """The one-screen summary of a finished run (or what failed), and the launcher's exit code."""
+    logs = out_dir / "logs"
     summary_path = out_dir / "summary.json"
-    if exit_code in (EXIT_OK, EXIT_INCOMPLETE) and summary_path.exists():
+    if seen.exit_code in (EXIT_OK, EXIT_INCOMPLETE) and summary_path.exists():
         from runtime.rundir import format_summary
 
         summary = json.loads(summary_path.read_text())
         print(format_summary(summary, out_dir).replace("anicov run:", f"launch_team ({args.clock}, over Zenoh):"))
         print(
-            f"  processes       coordinator + {scenario.agents} agents"
+            f"  processes       coordinator + {agents} agents"
             + ("" if args.no_record else " + logger")
             + f", logs in {logs}"
         )
-        if lost:
-            print(f"  lost on the way {', '.join(lost)} (the team completed without them)")
-        if restarts:
-            print(f"  coordinator     killed and restarted {restarts} time(s); it resumed from the agents' histories")
+        if seen.lost:
+            print(f"  lost on the way {', '.join(seen.lost)} (the team completed without them)")
+        if seen.restarts:
+            print(
+                f"  coordinator     killed and restarted {seen.restarts} time(s); it resumed from the agents' histories"
+            )
         if (out_dir / "recording.rrd").exists():
             print(f"  recording       {out_dir / 'recording.rrd'}   (anicov replay {out_dir / 'recording.rrd'})")
-        print(f"  wall time       {time.monotonic() - started:.1f} s")
+        print(f"  wall time       {wall:.1f} s")
         return EXIT_OK if summary["completed"] else EXIT_INCOMPLETE
-    print(f"launch_team: the run failed (exit {exit_code}); logs in {logs}", file=sys.stderr)
+    print(f"launch_team: the run failed (exit {seen.exit_code}); logs in {logs}", file=sys.stderr)
     for child in children:
         tail = child.log_path.read_text(errors="replace").strip().splitlines()[-3:]
         if child.process.returncode not in (0, None) and tail:

@@ -19,7 +19,7 @@ import numpy as np
 
 from anicov.engine import run_scenario
 from model.metrics import coverage_distance, optimum_time, straight_pass_coverage, total_sensing_ability
-from model.scenario import Scenario, ScenarioError, load_scenario
+from model.scenario import PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
 from model.zigzag import zigzag_pilots, zigzag_start_poses
 
 PAPER = {
@@ -32,7 +32,6 @@ PAPER = {
     "time_ratio_30": 5.0,
     "path_vs_zigzag": 0.55,
 }
-PAPER_SCENARIO = Path(__file__).resolve().parent.parent / "scenarios" / "paper.toml"
 
 
 def parse_team_range(text: str) -> list[int]:

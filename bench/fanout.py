@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import zenoh
 
 from bench.pingpong import free_port
-from protocol.bus import team_publisher, zenoh_config
+from protocol.session import team_publisher, zenoh_config
 
 
 def peer_config(router: str) -> zenoh.Config:

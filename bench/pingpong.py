@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import zenoh
 
-from protocol.bus import team_publisher, zenoh_config
+from protocol.session import team_publisher, zenoh_config
 
 
 def free_port() -> int:

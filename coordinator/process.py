@@ -25,35 +25,14 @@ from model.coverage_map import load_kernels as load_map_kernels
 from model.planning import Planner
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, RunResult
 from model.scenario import Scenario
-from protocol.bus import (
-    GAP_CHECK_PERIOD,
-    History,
-    Inbox,
-    LossTimer,
-    Membership,
-    Received,
-    Relay,
-    fetch,
-    fetch_snapshot,
-    fill_gaps,
-    open_session,
-    team_publisher,
-    write_counts,
-)
+from protocol.inbox import Inbox, Membership, Received
 from protocol.keys import TeamKeys, agent_of_key
-from protocol.messages import (
-    AgentState,
-    AgentStep,
-    Limits,
-    MapDelta,
-    Objectives,
-    RunControl,
-    Snapshot,
-    StepGo,
-    encode,
-)
+from protocol.messages import AgentState, AgentStep, Limits, MapDelta, Objectives, RunControl, Snapshot, StepGo, encode
+from protocol.recovery import GAP_CHECK_PERIOD, History, LossTimer, Relay, fetch, fetch_snapshot, fill_gaps
 from protocol.replica import MapReplica
+from protocol.session import open_session, team_publisher
 from runtime.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
+from runtime.rundir import write_counts
 
 log = logging.getLogger("anicov.coordinator")
 

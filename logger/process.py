@@ -19,18 +19,14 @@ import zenoh
 
 from logger.recording import RunRecorder
 from model.scenario import Scenario
-from protocol.bus import Inbox, Membership, Received, fetch, fetch_snapshot, open_session, write_counts
+from protocol.inbox import Inbox, Membership, Received
 from protocol.keys import TeamKeys
-from protocol.messages import (
-    AgentState,
-    AgentStep,
-    Limits,
-    Objectives,
-    RunControl,
-    StepGo,
-)
+from protocol.messages import AgentState, AgentStep, Limits, Objectives, RunControl, StepGo
+from protocol.recovery import fetch, fetch_snapshot
 from protocol.replica import MapReplica
+from protocol.session import open_session
 from runtime.lifecycle import EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
+from runtime.rundir import write_counts
 
 log = logging.getLogger("logger.process")
 

@@ -17,6 +17,10 @@ CONTROLLERS = ("paper", "paper-literal", "paper-eq16", "zigzag")
 read toward the objective but eq. 16 as printed; ``zigzag``: Fig. 8 (docs/paper-notes.md)."""
 
 
+PAPER_SCENARIO = Path(__file__).resolve().parent.parent / "scenarios" / "paper.toml"
+"""The paper's setting (Section V): the default scenario of every command."""
+
+
 class ScenarioError(ValueError):
     """A scenario file or value that cannot be used; the message names the key."""
 

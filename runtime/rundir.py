@@ -81,3 +81,9 @@ def format_summary(summary: dict[str, Any], out_dir: Path | None = None) -> str:
     if out_dir is not None:
         lines.append(f"  outputs         {out_dir}/")
     return "\n".join(lines)
+
+
+def write_counts(path: Path | None, counts: dict[str, object]) -> None:
+    """Persist a process's message counters (read by tests and the launcher's summary)."""
+    if path is not None:
+        path.write_text(json.dumps(counts, indent=2, sort_keys=True) + "\n", encoding="utf-8")

@@ -7,10 +7,12 @@ import pytest
 import zenoh
 
 from agents.process import END_ONLY
-from protocol.bus import History, Inbox, LossTimer, Received, Relay, fetch, fill_gaps, zenoh_config
+from protocol.inbox import Inbox, Received
 from protocol.keys import TeamKeys
 from protocol.messages import AgentState, AgentStep, Limits, MapDelta, RunControl, encode
+from protocol.recovery import History, LossTimer, Relay, fetch, fill_gaps
 from protocol.replica import MapReplica
+from protocol.session import zenoh_config
 from tests.teamrun import free_port, unique_team, wait_for
 
 LIMITS = Limits(rows=20, cols=20, agents=3)

@@ -18,19 +18,10 @@ import zenoh
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from protocol.bus import zenoh_config
+from protocol.decoding import decode
 from protocol.keys import TeamKeys
-from protocol.messages import (
-    AgentState,
-    AgentStep,
-    Limits,
-    MapDelta,
-    Objectives,
-    ProtocolError,
-    RunControl,
-    decode,
-    encode,
-)
+from protocol.messages import AgentState, AgentStep, Limits, MapDelta, Objectives, ProtocolError, RunControl, encode
+from protocol.session import zenoh_config
 from tests.teamrun import (
     anicov,
     anicov_command,

@@ -6,6 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from protocol.decoding import decode
 from protocol.messages import (
     PROTOCOL_VERSION,
     AgentState,
@@ -17,7 +18,6 @@ from protocol.messages import (
     RunControl,
     Snapshot,
     StepGo,
-    decode,
     encode,
 )
 

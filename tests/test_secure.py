@@ -12,7 +12,7 @@ from cryptography import x509
 from cryptography.hazmat.primitives.asymmetric import ec
 
 from anicov.secure import access_control, load_profile, make_profile
-from protocol.bus import zenoh_config
+from protocol.session import zenoh_config
 from tests.teamrun import anicov, free_port, launcher_command, processes_of, run, write_scenario
 
 TEAM = "sec"

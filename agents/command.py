@@ -1,0 +1,32 @@
+"""``anicov agent``: its arguments, and the start of one agent process from them.
+
+Light on imports: the CLI builds its parser from here; the process itself (Zenoh, numba) loads only
+when the command runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from model.scenario import ScenarioError
+from runtime.arguments import add_process_arguments, scenario_from_arguments
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--id", type=int, required=True, help="this agent's id, 0..N-1")
+    parser.add_argument("--counts", help="write message counters to this JSON file at exit")
+    add_process_arguments(parser)
+
+
+def main(args: argparse.Namespace) -> int:
+    from agents.process import AgentOptions, run_agent
+    from protocol.session import config_from_arguments
+    from runtime.lifecycle import StopFlag, setup_logging
+
+    setup_logging(f"agent-{args.id}", args.verbose)
+    stop = StopFlag().install()
+    scenario = scenario_from_arguments(args)
+    if not 0 <= args.id < scenario.agents:
+        raise ScenarioError(f"--id: expected an agent id from 0 to {scenario.agents - 1}, got {args.id}")
+    options = AgentOptions(args.team, args.id, args.clock, args.speed, args.drop_rate, args.counts)
+    return run_agent(scenario, options, config_from_arguments(args), stop)

@@ -1,0 +1,239 @@
+"""Decoding with validation: a payload becomes a typed message, or a :class:`ProtocolError` with a short,
+countable reason. Everything a receiver relies on is checked (version, type, field types, shapes,
+finite numbers, ids in range, map windows inside the grid, non-negative deltas); nothing that fails
+here may touch a map or a controller.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from typing import Any
+
+import msgpack
+import numpy as np
+
+from protocol.messages import (
+    MAX_PAYLOAD_BYTES,
+    PROTOCOL_VERSION,
+    RUN_CONTROL_KINDS,
+    AgentState,
+    AgentStep,
+    Limits,
+    MapDelta,
+    Message,
+    Objectives,
+    Pose,
+    ProtocolError,
+    RunControl,
+    Snapshot,
+    StepGo,
+)
+
+
+def _int(body: dict[str, Any], key: str, low: int, high: int) -> int:
+    value = body.get(key)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ProtocolError("bad-field", f"{key} must be an integer")
+    if not low <= value <= high:
+        raise ProtocolError("out-of-range", f"{key}={value} not in [{low}, {high}]")
+    return value
+
+
+def _finite(value: Any, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ProtocolError("not-finite", f"{name} must be a finite number")
+    return float(value)
+
+
+def _floats(body: dict[str, Any], key: str, length: int | None = None) -> list[float]:
+    value = body.get(key)
+    if not isinstance(value, list) or (length is not None and len(value) != length):
+        raise ProtocolError("bad-shape", f"{key} must be a list" + (f" of {length}" if length else ""))
+    return [_finite(item, key) for item in value]
+
+
+def _header(payload: bytes) -> dict[str, Any]:
+    if not isinstance(payload, bytes | bytearray | memoryview):
+        raise ProtocolError("not-bytes")
+    if len(payload) > MAX_PAYLOAD_BYTES:
+        raise ProtocolError("too-large", f"{len(payload)} bytes")
+    try:
+        body = msgpack.unpackb(payload, raw=False, strict_map_key=True, max_bin_len=MAX_PAYLOAD_BYTES)
+    except Exception as error:  # msgpack raises several unrelated types on garbage
+        raise ProtocolError("undecodable", type(error).__name__) from None
+    if not isinstance(body, dict):
+        raise ProtocolError("not-a-map")
+    if body.get("v") != PROTOCOL_VERSION:
+        raise ProtocolError("bad-version", f"expected {PROTOCOL_VERSION}, got {body.get('v')!r}")
+    return body
+
+
+MAX_STEP = 2**40
+
+
+def _inflate(packed: Any, size: int, name: str) -> bytes:
+    """Decompress a zlib field that must hold exactly ``size`` bytes (and never inflates past it)."""
+    if not isinstance(packed, bytes):
+        raise ProtocolError("bad-field", f"{name} must be bytes")
+    try:
+        raw = zlib.decompressobj().decompress(packed, size + 1)
+    except zlib.error:
+        raise ProtocolError("undecodable", f"{name} is not zlib data") from None
+    if len(raw) != size:
+        raise ProtocolError("bad-shape", f"{name} must hold {size} bytes")
+    return raw
+
+
+def _members(body: dict[str, Any], last_agent: int) -> list[int]:
+    """A list of distinct agent ids in range."""
+    members = body.get("members")
+    if not isinstance(members, list) or any(isinstance(m, bool) or not isinstance(m, int) for m in members):
+        raise ProtocolError("bad-field", "members must be a list of integers")
+    if any(not 0 <= m <= last_agent for m in members) or len(set(members)) != len(members):
+        raise ProtocolError("out-of-range", "members must be distinct agent ids")
+    return members
+
+
+def _decode_delta(body: dict[str, Any], limits: Limits) -> MapDelta:
+    last_agent = limits.agents - 1
+    agent = _int(body, "agent", 0, last_agent)
+    seq = _int(body, "seq", 0, MAX_STEP)
+    height = _int(body, "h", 0, limits.rows)
+    width = _int(body, "w", 0, limits.cols)
+    row0 = _int(body, "row0", 0, limits.rows)
+    col0 = _int(body, "col0", 0, limits.cols)
+    if row0 + height > limits.rows or col0 + width > limits.cols:
+        raise ProtocolError("window-outside-grid", f"{height}x{width} at ({row0}, {col0})")
+    raw = body.get("ticks")
+    if not isinstance(raw, bytes) or len(raw) != 8 * height * width:
+        raise ProtocolError("bad-shape", "ticks must hold h*w int64")
+    ticks = np.frombuffer(raw, dtype="<i8").reshape(height, width).astype(np.int64)
+    if (ticks < 0).any():
+        raise ProtocolError("negative-delta")
+    return MapDelta(agent, seq, row0, col0, ticks)
+
+
+def _decode_state(body: dict[str, Any], limits: Limits) -> AgentState:
+    pose = _floats(body, "pose", 3)
+    vel = _floats(body, "vel", 2)
+    nxt = _floats(body, "next", 3)
+    e_omega = _finite(body.get("e_omega"), "e_omega")
+    if not 0.0 <= e_omega <= 1.0:
+        raise ProtocolError("out-of-range", "e_omega not in [0, 1]")
+    return AgentState(
+        _int(body, "agent", 0, limits.agents - 1),
+        _int(body, "step", -1, MAX_STEP),
+        (pose[0], pose[1], pose[2]),
+        vel[0],
+        vel[1],
+        e_omega,
+        (nxt[0], nxt[1], nxt[2]),
+    )
+
+
+def _submap(body: dict[str, Any], key: str) -> dict[str, Any]:
+    value = body.get(key)
+    if not isinstance(value, dict):
+        raise ProtocolError("bad-field", f"{key} must be a map")
+    return value
+
+
+def _submaps(body: dict[str, Any], key: str, most: int) -> list[dict[str, Any]]:
+    value = body.get(key, [])
+    if not isinstance(value, list) or len(value) > most or not all(isinstance(item, dict) for item in value):
+        raise ProtocolError("bad-field", f"{key} must be a list of maps, at most one per agent")
+    return value
+
+
+def _decode_objectives(body: dict[str, Any], limits: Limits) -> Objectives:
+    last_agent = limits.agents - 1
+    step = _int(body, "step", 0, MAX_STEP)
+    members = _members(body, last_agent)
+    targets = _floats(body, "targets", 2 * len(members))
+    blobs = _floats(body, "blobs")
+    if len(blobs) % 2:
+        raise ProtocolError("bad-shape", "blobs must hold (x, y) pairs")
+    labels = None
+    if body.get("labels") is not None:
+        raw = _inflate(body["labels"], 2 * limits.rows * limits.cols, "labels")
+        labels = np.frombuffer(raw, dtype="<u2").reshape(limits.rows, limits.cols).astype(np.uint16)
+        if labels.max(initial=0) > len(blobs) // 2:
+            raise ProtocolError("out-of-range", "labels name a blob that does not exist")
+    return Objectives(step, tuple(members), np.array(targets).reshape(-1, 2), np.array(blobs).reshape(-1, 2), labels)
+
+
+def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Message:
+    """Decode and validate one payload; raise ProtocolError (with ``.reason``) if it is not acceptable."""
+    body = _header(payload)
+    kind = body.get("type")
+    if expected is not None and kind != expected:
+        raise ProtocolError("wrong-type", f"expected {expected}, got {kind!r}")
+    last_agent = limits.agents - 1
+    if kind == "delta":
+        return _decode_delta(body, limits)
+    if kind == "state":
+        return _decode_state(body, limits)
+    if kind == "step":
+        delta = _decode_delta(_submap(body, "delta"), limits)
+        state = _decode_state(_submap(body, "state"), limits)
+        if delta.agent != state.agent or delta.seq != state.step:
+            raise ProtocolError("out-of-range", "a step's delta and state must be of one agent and one step")
+        return AgentStep(delta, state)
+    if kind == "objectives":
+        return _decode_objectives(body, limits)
+    if kind == "go":
+        step = _int(body, "step", 0, MAX_STEP)
+        members = _members(body, last_agent)
+        deltas = [_decode_delta(item, limits) for item in _submaps(body, "deltas", limits.agents)]
+        states = [_decode_state(item, limits) for item in _submaps(body, "states", limits.agents)]
+        if any(delta.seq != step - 1 for delta in deltas) or any(state.step != step - 1 for state in states):
+            raise ProtocolError("out-of-range", "a go for step k carries deltas and states of step k-1 only")
+        if len({delta.agent for delta in deltas}) != len(deltas) or len({s.agent for s in states}) != len(states):
+            raise ProtocolError("out-of-range", "one delta and one state per agent")
+        raw_objectives = body.get("objectives")
+        if raw_objectives is not None and not isinstance(raw_objectives, dict):
+            raise ProtocolError("bad-field", "objectives must be a map or nil")
+        objectives = None if raw_objectives is None else _decode_objectives(raw_objectives, limits)
+        return StepGo(step, tuple(members), tuple(deltas), objectives, tuple(states))
+    if kind == "control":
+        control_kind = body.get("kind")
+        if control_kind not in RUN_CONTROL_KINDS:
+            raise ProtocolError("bad-field", f"kind must be one of {RUN_CONTROL_KINDS}")
+        completed = body.get("completed")
+        reason = body.get("reason")
+        if not isinstance(completed, bool) or not isinstance(reason, str) or len(reason) > 1000:
+            raise ProtocolError("bad-field", "completed must be a bool and reason a short string")
+        return RunControl(
+            control_kind, _int(body, "step", 0, MAX_STEP), completed, _finite(body.get("e_d"), "e_d"), reason
+        )
+    if kind == "snapshot":
+        rows = _int(body, "rows", limits.rows, limits.rows)
+        cols = _int(body, "cols", limits.cols, limits.cols)
+        raw = _inflate(body.get("map"), 8 * rows * cols, "map")
+        coverage = np.frombuffer(raw, dtype="<i8").reshape(rows, cols).astype(np.int64)
+        if (coverage < 0).any():
+            raise ProtocolError("negative-delta", "map cells must be non-negative")
+        applied_raw = body.get("applied")
+        if not isinstance(applied_raw, list):
+            raise ProtocolError("bad-field", "applied must be a list")
+        applied: dict[int, tuple[int, tuple[int, ...]]] = {}
+        for entry in applied_raw:
+            if not (isinstance(entry, list) and len(entry) == 3 and isinstance(entry[2], list)):
+                raise ProtocolError("bad-shape", "applied entries are [agent, seq, extras]")
+            agent = _int({"a": entry[0]}, "a", 0, last_agent)
+            seq = _int({"s": entry[1]}, "s", -1, MAX_STEP)
+            extras = tuple(_int({"e": item}, "e", seq + 1, MAX_STEP) for item in entry[2])
+            applied[agent] = (seq, extras)
+        poses: dict[int, Pose] = {}
+        poses_raw = body.get("poses", [])
+        if not isinstance(poses_raw, list):
+            raise ProtocolError("bad-field", "poses must be a list")
+        for entry in poses_raw:
+            if not (isinstance(entry, list) and len(entry) == 4):
+                raise ProtocolError("bad-shape", "pose entries are [agent, x, y, theta]")
+            agent = _int({"a": entry[0]}, "a", 0, last_agent)
+            x, y, theta = (_finite(value, "pose") for value in entry[1:])
+            poses[agent] = (x, y, theta)
+        return Snapshot(coverage, applied, poses)
+    raise ProtocolError("unknown-type", repr(kind)[:40])

@@ -1,0 +1,63 @@
+"""The command-line arguments every part of a run shares, and the scenario they select.
+
+``anicov run``, ``launch_team.py`` and each process (``anicov agent | coordinator | logger``) build their
+parsers from these, so a flag means the same everywhere and the CLI and the launcher need not import
+each other.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from model.scenario import CONTROLLERS, PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
+
+CLOCKS = ("lockstep", "realtime")
+
+
+def add_scenario_arguments(parser: argparse.ArgumentParser, controllers: tuple[str, ...] = CONTROLLERS) -> None:
+    """--config, --n, --seed, --controller: which scenario, with overrides of its keys."""
+    parser.add_argument("--config", help="scenario TOML (default: scenarios/paper.toml)")
+    parser.add_argument("--n", type=int, help="team size (overrides the scenario's 'agents'; the paper's is 4)")
+    parser.add_argument("--seed", type=int, help="seed of the initial poses (overrides 'seed')")
+    parser.add_argument("--controller", choices=controllers, help="control law (overrides 'controller')")
+
+
+def add_team_arguments(parser: argparse.ArgumentParser) -> None:
+    """The scenario arguments of a team on the bus (no zig-zag there), and its clock."""
+    add_scenario_arguments(parser, tuple(c for c in CONTROLLERS if c != "zigzag"))
+    parser.add_argument(
+        "--clock",
+        choices=CLOCKS,
+        default="lockstep",
+        help="lockstep: deterministic, equal to 'anicov run'; realtime: wall-clock steps",
+    )
+    parser.add_argument(
+        "--speed",
+        type=float,
+        default=10.0,
+        help="realtime only: simulated time units per wall-clock second (default 10)",
+    )
+
+
+def add_process_arguments(parser: argparse.ArgumentParser) -> None:
+    """What a team process (agent, coordinator, logger) is told: the team and how to reach the bus."""
+    add_team_arguments(parser)
+    parser.add_argument("--team", default="team", help="team name: keys live under anicov/<team>/")
+    parser.add_argument(
+        "--connect", action="append", help="Zenoh endpoint to connect to (repeatable), e.g. tcp/192.168.1.10:7447"
+    )
+    parser.add_argument("--listen", action="append", help="Zenoh endpoint to listen on (peer mode)")
+    parser.add_argument("--mode", choices=("client", "peer"), default="client", help="Zenoh mode (default client)")
+    parser.add_argument("--zenoh-config", help="a Zenoh JSON5 config file (see deploy/); flags add endpoints")
+    parser.add_argument("--drop-rate", type=float, default=0.0, help=argparse.SUPPRESS)  # test hook
+    parser.add_argument("--verbose", action="store_true", help="debug logging")
+
+
+def scenario_from_arguments(args: argparse.Namespace) -> Scenario:
+    """The scenario file (or the paper's) with the command line's overrides applied and checked."""
+    scenario = load_scenario(args.config or PAPER_SCENARIO)
+    scenario = scenario.with_overrides(agents=args.n, seed=args.seed, controller=args.controller)
+    speed = getattr(args, "speed", None)
+    if speed is not None and speed <= 0:
+        raise ScenarioError(f"--speed: expected a positive number, got {speed}")
+    return scenario
