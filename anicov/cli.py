@@ -22,8 +22,7 @@ def command_run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from anicov.engine import run_scenario
-    from runtime.plots import write_run_plots
-    from runtime.rundir import format_summary, summary_of, write_summary, write_trajectory
+    from runtime.rundir import format_summary, write_run_directory
 
     scenario = scenario_from_arguments(args)
     out_dir = Path(args.out)
@@ -36,10 +35,7 @@ def command_run(args: argparse.Namespace) -> int:
             bar.update(round(100 * (1 - domain_error)) - bar.n)
 
         result = run_scenario(scenario, progress=progress)
-    write_trajectory(result, out_dir / "trajectory.csv")
-    summary = summary_of(result)
-    write_summary(summary, out_dir / "summary.json")
-    write_run_plots(result, out_dir)
+    summary = write_run_directory(result, out_dir)
     if not args.no_record:
         from logger.recording import record_result
 

@@ -1,4 +1,4 @@
-"""What a run leaves behind: trajectory.csv, summary.json and the one-screen summary.
+"""What a run leaves behind: trajectory.csv, summary.json, the counters and the one-screen summary.
 
 Numbers are written with Python's shortest round-trip ``repr``, so the same
 run gives byte-identical files and a reader recovers the exact floats.
@@ -87,3 +87,18 @@ def write_counts(path: Path | None, counts: dict[str, object]) -> None:
     """Persist a process's message counters (read by tests and the launcher's summary)."""
     if path is not None:
         path.write_text(json.dumps(counts, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+
+
+def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, object] | None = None) -> dict[str, Any]:
+    """trajectory.csv, summary.json, the plots and, from the coordinator, coordinator_counts.json: what
+    ``anicov run`` and a team over the bus leave alike. Returns the summary."""
+    from runtime.plots import write_run_plots
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_trajectory(result, out_dir / "trajectory.csv")
+    summary = summary_of(result)
+    write_summary(summary, out_dir / "summary.json")
+    if counts is not None:
+        write_counts(out_dir / "coordinator_counts.json", counts)
+    write_run_plots(result, out_dir)
+    return summary

@@ -1,0 +1,70 @@
+"""The end of a run: announce it, let the last deltas land, write the counts and the run directory."""
+
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+
+from coordinator.endpoints import CoordinatorBus
+from coordinator.stepping import Stepping
+from protocol.messages import RunControl, encode
+from protocol.recovery import fill_gaps
+from runtime.rundir import write_run_directory
+
+log = logging.getLogger("anicov.coordinator")
+
+
+def announce_end(bus: CoordinatorBus, stepping: Stepping) -> bytes | None:
+    """'done' with the outcome (kept in the go history for whoever lost it), or 'abort' if stopped."""
+    node = bus.node
+    if stepping.outcome is None:
+        reason = "coordinator stopped"
+        bus.announce(RunControl("abort", stepping.step, False, node.replica.map.domain_error(), reason=reason))
+        return None
+    steps, completed, _ = stepping.outcome
+    done = encode(RunControl("done", steps, completed, node.replica.map.domain_error()))
+    bus.go_history.final = [done]  # an agent that lost the end of the run finds it here
+    bus.publish(bus.control, done)
+    log.info(
+        "run %s after %d steps (e_D = %.4f)",
+        "complete" if completed else "incomplete",
+        steps,
+        node.replica.map.domain_error(),
+    )
+    return done
+
+
+def settle_last_deltas(bus: CoordinatorBus, done: bytes | None) -> None:
+    """Deltas still in flight (realtime agents step until they hear the end) join the map, and those lost
+    on the way, last ones included (see fill_gaps). Lockstep: nothing is in flight, the last go closed
+    every step."""
+    node = bus.node
+    realtime = node.open_step is None
+    node.open_step = None
+    if realtime:
+        node.inbox.drain(0.5, node.handle)
+    if done is not None:
+        bus.publish(bus.control, done)  # again, for whoever lost the first (it is idempotent)
+    if realtime:
+        fill_gaps(bus.session, bus.keys, node.replica, node.inbox, to_the_end=range(node.scenario.agents))
+        node.inbox.drain(0.5, node.handle)
+
+
+def write_outputs(bus: CoordinatorBus, stepping: Stepping, resumed_at: int | None, out: str | None) -> None:
+    """The counters, and (a finished run with --out) trajectory.csv, summary.json and the plots, written while
+    still on the bus: a late logger can fetch the final map's snapshot meanwhile."""
+    node = bus.node
+    counts = (
+        node.inbox.counts()
+        | node.replica.counts()
+        | {
+            "bytes_sent": node.bytes_sent,
+            "wall_seconds": time.monotonic() - stepping.began,
+            "events": node.log.events,
+            "resumed_at": resumed_at,
+        }
+    )
+    if stepping.outcome is not None and out:
+        steps, completed, completion_step = stepping.outcome
+        write_run_directory(node.result(steps, completed, completion_step), Path(out), counts)

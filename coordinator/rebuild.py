@@ -1,0 +1,87 @@
+"""A restarted coordinator: the run rebuilt from the agents' histories, as the lost coordinator lived it.
+
+Step by step from 0, the deltas of step s−1 enter the replica (Λ_s), e_D and the map snapshots are
+logged, the states of step s are recorded and, in lockstep on a replanning step, the planner runs on
+Λ_s and the poses of step s, so its memory of blobs is the one the lost coordinator had. The run
+resumes at the latest step every member has published. In lockstep that step is still open (its
+deltas go into the next go), so a run that lost its coordinator still equals the engine. Agents gone
+before the restart left no history: their coverage is adopted from a member's snapshot.
+"""
+
+from __future__ import annotations
+
+from coordinator.node import Coordinator
+from model.run import snapshot_steps
+from protocol.inbox import Received
+from protocol.messages import AgentState, MapDelta, Snapshot
+
+History = list[MapDelta | AgentState]
+"""Deltas and states read from the agents' histories, in any order."""
+
+
+def by_step(messages: History, members: set[int]) -> tuple[dict[int, list[MapDelta]], dict[int, list[AgentState]]]:
+    """The members' deltas by sequence and their states (not hellos) by step."""
+    deltas: dict[int, list[MapDelta]] = {}
+    states: dict[int, list[AgentState]] = {}
+    for message in messages:
+        if isinstance(message, MapDelta) and message.agent in members:
+            deltas.setdefault(message.seq, []).append(message)
+        elif isinstance(message, AgentState) and message.step >= 0 and message.agent in members:
+            states.setdefault(message.step, []).append(message)
+    return deltas, states
+
+
+def resume_step(states: dict[int, list[AgentState]], members: set[int]) -> tuple[int, set[int]]:
+    """The latest step every agent that published has published, and those agents."""
+    latest: dict[int, int] = {}
+    for step, of_step in states.items():
+        for state in of_step:
+            latest[state.agent] = max(latest.get(state.agent, -1), step)
+    if not latest:
+        raise RuntimeError(f"the team is running but no history of agents {sorted(members)} could be read")
+    return min(latest.values()), set(latest)
+
+
+def rebuild(node: Coordinator, messages: History, members: set[int], snapshot: Snapshot | None = None) -> int:
+    """Replay the histories into ``node``; return the step to resume at (see the module's docstring)."""
+    deltas, states = by_step(messages, members)
+    resume, publishing = resume_step(states, members)
+    with node.lock:
+        node.members = publishing
+        replay(node, deltas, states, resume)
+        gone = set(snapshot.applied) - members if snapshot is not None else set()
+        if gone and snapshot is not None:
+            node.replica.adopt(snapshot, [m for m in messages if isinstance(m, MapDelta)], gone)
+            node.log.events.append(f"coverage of agents {sorted(gone)} taken from a member's snapshot")
+        if node.open_step is not None:
+            node.open_step = resume
+        # What lies beyond: the open step's deltas (for the next go) and any later ones.
+        for message in messages:
+            if isinstance(message, MapDelta) and message.seq >= resume and message.agent in members:
+                node.handle_locked(Received("", message))
+            elif isinstance(message, AgentState) and message.step >= resume and message.agent in members:
+                node.handle_locked(Received("", message))
+    return resume
+
+
+def replay(
+    node: Coordinator, deltas: dict[int, list[MapDelta]], states: dict[int, list[AgentState]], resume: int
+) -> None:
+    """Steps 0..resume as the lost coordinator lived them: Λ_s, e_D, snapshots, states, and the plans."""
+    every = snapshot_steps(node.scenario.dt)
+    lockstep = node.open_step is not None
+    for step in range(resume + 1):
+        if step > 0:
+            for delta in deltas.get(step - 1, []):
+                node.replica.apply(delta)
+            node.log.errors.append(node.replica.map.domain_error())
+        if step % every == 0:
+            node.take_snapshot(step * node.scenario.dt)
+        for state in states.get(step, []):
+            node.log.record(state)
+            node.positions[state.agent] = (state.pose[0], state.pose[1])
+        if lockstep and step % node.scenario.replan_steps == 0:
+            node.plan(step)
+        for state in states.get(step, []):
+            node.latest_state_step[state.agent] = step
+            node.positions[state.agent] = (state.next_pose[0], state.next_pose[1])

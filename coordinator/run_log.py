@@ -1,0 +1,65 @@
+"""What the coordinator saw of a run: trace rows, e_D(t), snapshots, final poses, events; and the
+RunResult built from them, so a team over the bus writes the same run directory as the engine."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from model.run import TRACE_FIELDS, RunResult, quantised_lack
+from model.scenario import Scenario
+from protocol.messages import AgentState
+
+
+@dataclass
+class RunLog:
+    """What the coordinator saw of the run, enough to write the same outputs as the engine."""
+
+    agents: int
+    rows: dict[int, np.ndarray] = field(default_factory=dict)  # step → (N, 6), NaN where unseen
+    errors: list[float] = field(default_factory=lambda: [1.0])
+    final_poses: dict[int, tuple[float, float, float]] = field(default_factory=dict)
+    snapshot_times: list[float] = field(default_factory=list)
+    snapshots: list[np.ndarray] = field(default_factory=list)
+    events: list[str] = field(default_factory=list)
+    last_step: dict[int, int] = field(default_factory=dict)
+
+    def record(self, state: AgentState) -> None:
+        """Keep a state's trace row and, if it is the agent's latest, its pose at the end of the step."""
+        if state.step >= 0:
+            row = self.rows.get(state.step)
+            if row is None:
+                row = self.rows[state.step] = np.full((self.agents, len(TRACE_FIELDS)), np.nan)
+            row[state.agent] = (*state.pose, state.v, state.omega, state.e_omega)
+        if state.step >= self.last_step.get(state.agent, -2):
+            self.final_poses[state.agent] = state.next_pose
+            self.last_step[state.agent] = state.step
+
+    def take_snapshot(self, time_now: float, lack: np.ndarray) -> None:
+        self.snapshot_times.append(time_now)
+        self.snapshots.append(quantised_lack(lack))
+
+    def result(
+        self, scenario: Scenario, steps: int, completed: bool, completion_step: int, final_lack: np.ndarray
+    ) -> RunResult:
+        """A RunResult like the engine's: NaN rows where a realtime state was never heard."""
+        trace = np.full((steps + 1, self.agents, len(TRACE_FIELDS)), np.nan)
+        for step, row in self.rows.items():
+            if step < steps:
+                trace[step] = row
+        for agent, pose in self.final_poses.items():
+            trace[steps, agent, :3] = pose
+            trace[steps, agent, 3:] = 0.0
+        return RunResult(
+            scenario=scenario,
+            completed=completed,
+            completion_time=completion_step * scenario.dt if completed else math.inf,
+            steps=steps,
+            trace=trace,
+            errors=np.array(self.errors[: steps + 1]),
+            snapshot_times=self.snapshot_times,
+            snapshots=self.snapshots,
+            final_lack=final_lack,
+        )
