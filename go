@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One entry point for a fresh clone: every command first makes sure .venv exists and is current.
 #   ./go team [ARGS]       a 4-agent team over Zenoh, as separate processes (launch_team.py)
-#   ./go test [ARGS]       the test suite (what CI runs)
+#   ./go test [ARGS]       ruff, the import contracts and the test suite (what CI runs)
 #   ./go run ARGS          anicov run ... (one team in process)
 #   ./go reproduce ARGS    anicov reproduce ... (the paper's experiments)
 #   ./go bench             the benchmarks in bench/
@@ -34,6 +34,7 @@ case "$command" in
     test)
         setup
         "$VENV/bin/ruff" check .
+        "$VENV/bin/lint-imports"  # the layout's contracts (pyproject.toml [tool.importlinter])
         exec "$VENV/bin/python" -m pytest "$@"
         ;;
     team) setup; exec "$VENV/bin/python" launch_team.py --n 4 "$@" ;;

@@ -3,6 +3,16 @@
 The map is a grid of cells of side ``cell``; cell (row, col) has its centre at
 ((col + ½)·cell, (row + ½)·cell). Coverage is held in fixed-point ticks
 (:mod:`model.fixed_point`) so deltas from different agents commute exactly.
+
+:func:`sense_wedge` makes one pass over the wedge's cells and returns:
+
+- e_Ω, eq. 6: mean lack of coverage over the wedge's cells. Cells outside the domain are in the wedge
+  (S_Ω is the area the camera sees) but have nothing left to cover, Υ = 0.
+- w_left, w_right: the integral of eq. 9 split by side. Over uncovered cells (Ω − Υ₀) the integrand
+  (R − r)(θ_i − θ_x)/(R F θ_ix) is ±(R − r)/(R F); w_left sums (R − r)/(R F)·cell² over uncovered
+  cells to the left of the heading (θ_x > θ_i), w_right those to the right, so
+  ∂ẽ/∂θ_i = (w_right − w_left)/Λ*.
+- the coverage delta of eq. 3, Λ += α_i·dt, as a window of fixed-point ticks clipped to the grid.
 """
 
 from __future__ import annotations
@@ -35,6 +45,32 @@ def lack_of_coverage(coverage_ticks: int, target_ticks: int) -> float:
 
 
 @njit(cache=True)
+def wedge_polar(
+    cx: float,
+    cy: float,
+    heading_x: float,
+    heading_y: float,
+    sensing_range: float,
+    half_angle: float,
+    cos_half_angle: float,
+) -> tuple[float, float, float]:
+    """(r, θ_ix, across) of a point at (cx, cy) from the robot when it lies in the wedge (the support of
+    eq. 2), else r = −1. ``across`` > 0: the point is left of the heading."""
+    distance = math.sqrt(cx * cx + cy * cy)
+    if distance > sensing_range:
+        return -1.0, 0.0, 0.0
+    along = cx * heading_x + cy * heading_y
+    across = heading_x * cy - heading_y * cx
+    # Cheap rejection before the arctangent: outside the cone cos(offset) < cos F.
+    if along < distance * cos_half_angle - 1e-12:
+        return -1.0, 0.0, 0.0
+    offset = abs(math.atan2(across, along)) if distance > 0.0 else 0.0
+    if offset > half_angle:
+        return -1.0, 0.0, 0.0
+    return distance, offset, across
+
+
+@njit(cache=True)
 def sense_wedge(
     coverage: np.ndarray,
     target_ticks: int,
@@ -49,19 +85,9 @@ def sense_wedge(
 ) -> tuple[float, float, float, int, int, np.ndarray]:
     """One pass over agent i's wedge Ω_i: what it reads from the map and what it adds to it.
 
-    Returns (e_Ω, w_left, w_right, row0, col0, ticks):
-
-    - e_Ω, eq. 6: mean lack of coverage over the wedge's cells. Cells outside
-      the domain are in the wedge (S_Ω is the area the camera sees) but have
-      nothing left to cover, Υ = 0.
-    - w_left, w_right: the integral of eq. 9 split by side. Over uncovered
-      cells (Ω − Υ₀) the integrand (R − r)(θ_i − θ_x)/(R F θ_ix) is
-      ±(R − r)/(R F); w_left sums (R − r)/(R F)·cell² over uncovered cells to
-      the left of the heading (θ_x > θ_i), w_right those to the right, so
-      ∂ẽ/∂θ_i = (w_right − w_left)/Λ*.
-    - the coverage delta of eq. 3, Λ += α_i·dt, as a window of fixed-point
-      ticks clipped to the grid, whose top-left cell is (row0, col0). The
-      map is only read here: deltas are applied once every agent has read.
+    Returns (e_Ω, w_left, w_right, row0, col0, ticks): e_Ω of eq. 6, the two sides of eq. 9's integral,
+    and the delta of eq. 3 as a window of ticks whose top-left cell is (row0, col0); see the module's
+    docstring. The map is only read here: deltas are applied once every agent has read.
     """
     rows, cols = coverage.shape
     row0, row1, col0, col1 = wedge_cell_range(x, y, theta, sensing_range, half_angle, cell)
@@ -82,16 +108,10 @@ def sense_wedge(
         row_inside = 0 <= row < rows
         for col in range(col0, col1):
             cx = (col + 0.5) * cell - x
-            distance = math.sqrt(cx * cx + cy * cy)
-            if distance > sensing_range:
-                continue
-            along = cx * heading_x + cy * heading_y
-            across = heading_x * cy - heading_y * cx  # > 0: the cell is left of the heading
-            # Cheap rejection before the arctangent: outside the cone cos(offset) < cos F.
-            if along < distance * cos_half_angle - 1e-12:
-                continue
-            offset = abs(math.atan2(across, along)) if distance > 0.0 else 0.0
-            if offset > half_angle:
+            distance, offset, across = wedge_polar(
+                cx, cy, heading_x, heading_y, sensing_range, half_angle, cos_half_angle
+            )
+            if distance < 0.0:
                 continue
             cells_in_wedge += 1
             if not row_inside or col < 0 or col >= cols:
