@@ -175,11 +175,32 @@ def plot_reproduction(report: dict[str, Any], base: Scenario, zigzag_result: Any
     import matplotlib
 
     matplotlib.use("Agg")
+    teams = [row for row in report["teams"] if row["mean_time_ratio"] is not None]
+    _plot_straight_pass(report, base, out_dir / "fig7_straight_pass.png")
+    _plot_zigzag(report, base, zigzag_result, out_dir / "fig8_zigzag.png")
+    _plot_time_ratio(report, base, teams, out_dir / "fig9_time_ratio.png")
+    _plot_path_length(report, teams, out_dir / "fig10_path_length.png")
+
+
+def _figure(figsize: tuple[float, float]) -> tuple[Any, Any]:
     import matplotlib.pyplot as plt
 
+    return plt.subplots(figsize=figsize)
+
+
+def _save(fig: Any, path: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _plot_straight_pass(report: dict[str, Any], base: Scenario, path: Path) -> None:
+    """Fig. 7: the coverage across one straight pass, with d100 and d50 marked."""
     offsets = np.linspace(0.0, base.range * math.sin(base.half_angle), 200)
     profile = [straight_pass_coverage(d, base.range, base.half_angle, base.alpha_max) for d in offsets]
-    fig, ax = plt.subplots(figsize=(6, 3.5))
+    fig, ax = _figure((6, 3.5))
     ax.plot(np.concatenate([-offsets[::-1], offsets]), np.concatenate([profile[::-1], profile]), color="black")
     for level, key in ((base.lambda_star, "d100"), (base.lambda_star / 2, "d50")):
         ax.axhline(level, color="grey", linewidth=0.6)
@@ -188,11 +209,12 @@ def plot_reproduction(report: dict[str, Any], base: Scenario, zigzag_result: Any
     ax.set_xlabel("distance perpendicular to the pass")
     ax.set_ylabel("coverage Λ")
     ax.set_title("Coverage of one straight pass at v = 1 (Fig. 7)")
-    fig.tight_layout()
-    fig.savefig(out_dir / "fig7_straight_pass.png", dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
-    fig, ax = plt.subplots(figsize=(5.5, 4.5))
+
+def _plot_zigzag(report: dict[str, Any], base: Scenario, zigzag_result: Any, path: Path) -> None:
+    """Fig. 8: the zig-zag agent's path and waypoints in the domain."""
+    fig, ax = _figure((5.5, 4.5))
     waypoints = zigzag_pilots(base.with_overrides(controller="zigzag", agents=1))[0].waypoints
     ax.plot(zigzag_result.trace[:, 0, 0], zigzag_result.trace[:, 0, 1], color="tab:blue", linewidth=0.8)
     ax.plot(waypoints[:, 0], waypoints[:, 1], ".", color="tab:red", markersize=3)
@@ -200,14 +222,14 @@ def plot_reproduction(report: dict[str, Any], base: Scenario, zigzag_result: Any
     ax.plot([0, width, width, 0, 0], [0, 0, height, height, 0], "k--", linewidth=0.8)
     ax.set_aspect("equal")
     ax.set_title(f"Zig-zag path: t₁ = {report['zigzag_time_1']:.1f}, length {report['zigzag_path_1']:.1f} (Fig. 8)")
-    fig.tight_layout()
-    fig.savefig(out_dir / "fig8_zigzag.png", dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
-    teams = [row for row in report["teams"] if row["mean_time_ratio"] is not None]
+
+def _plot_time_ratio(report: dict[str, Any], base: Scenario, teams: list[dict[str, Any]], path: Path) -> None:
+    """Fig. 9: t_N / t*_N per team size, beside the paper's curve, the zig-zag and the optimum."""
     sizes = np.array([row["n"] for row in teams])
     area = base.domain[0] * base.domain[1]
-    fig, ax = plt.subplots(figsize=(6, 3.8))
+    fig, ax = _figure((6, 3.8))
     if len(teams):
         ax.errorbar(
             sizes,
@@ -227,11 +249,13 @@ def plot_reproduction(report: dict[str, Any], base: Scenario, zigzag_result: Any
     ax.set_ylim(0, None)
     ax.legend(fontsize=8)
     ax.set_title("Time to completion relative to the optimum (Fig. 9)")
-    fig.tight_layout()
-    fig.savefig(out_dir / "fig9_time_ratio.png", dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
-    fig, ax = plt.subplots(figsize=(6, 3.8))
+
+def _plot_path_length(report: dict[str, Any], teams: list[dict[str, Any]], path: Path) -> None:
+    """Fig. 10: the team's path length per team size, beside the zig-zag's and the paper's 55 %."""
+    sizes = np.array([row["n"] for row in teams])
+    fig, ax = _figure((6, 3.8))
     if len(teams):
         ax.plot(sizes, [row["mean_team_path"] for row in teams], "o-", markersize=3, label="ours (mean team path)")
     ax.axhline(report["zigzag_path_1"], color="tab:red", label="zig-zag")
@@ -241,6 +265,4 @@ def plot_reproduction(report: dict[str, Any], base: Scenario, zigzag_result: Any
     ax.set_ylim(0, None)
     ax.legend(fontsize=8)
     ax.set_title("Path length of the team (Fig. 10)")
-    fig.tight_layout()
-    fig.savefig(out_dir / "fig10_path_length.png", dpi=110)
-    plt.close(fig)
+    _save(fig, path)

@@ -74,6 +74,15 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3, help="runs of each N = 4 variant (default 3)")
     args = parser.parse_args()
     print(f"machine: {describe_machine()}")
+    rtt, peer = bare_round_trips()
+    small_teams(rtt, peer)
+    logger_cost(args.repeats, rtt, peer)
+    if not args.skip_30:
+        team_of_30()
+
+
+def bare_round_trips() -> tuple[dict[str, float], dict[str, float]]:
+    """Zenoh's round trips via a router and between peers, and a step's exchange with no work in it."""
     rtt = ping(2000, 256)
     print(
         f"bare Zenoh ping-pong between two processes via a router: median {rtt['median_us']:.0f} µs, "
@@ -86,53 +95,68 @@ def main() -> None:
         f"a lockstep step's exchange with no work (go of 10.7 kB to 4 echo processes, 4 replies of 3.1 kB): "
         f"median {floor['median_us']:.0f} µs = {floor['median_us'] / peer['median_us']:.1f} peer round trips"
     )
-    for agents in (1, 2):  # the same per-step cost with fewer processes sharing the two cores
+    return rtt, peer
+
+
+def small_teams(rtt: dict[str, float], peer: dict[str, float]) -> None:
+    """The same per-step cost with fewer processes sharing the two cores."""
+    for agents in (1, 2):
         row = run_team(agents, None)
         per_step = row["stepping_s"] / row["steps"] * 1e6
         print(
             f"N = {agents}: {per_step:.0f} µs a step = {per_step / peer['median_us']:.1f} peer / "
             f"{per_step / rtt['median_us']:.1f} router round trips ({row['steps']} steps)"
         )
-    # Without and with the logger, interleaved, so a slow spell of a shared machine hits both alike.
+
+
+def logger_cost(repeats: int, rtt: dict[str, float], peer: dict[str, float]) -> None:
+    """N = 4 without and with the logger, interleaved, so a slow spell of a shared machine hits both alike."""
     plain: list[dict[str, float]] = []
     recorded: list[dict[str, float]] = []
-    for _ in range(args.repeats):
+    for _ in range(repeats):
         plain.append(run_team(4, None))
         recorded.append(run_team(4, None, record=True))
-    print(f"\nN = 4, paper scenario, {args.repeats} runs each (median, then min – max):")
+    print(f"\nN = 4, paper scenario, {repeats} runs each (median, then min – max):")
     print(
         "| variant | steps | stepping time (s) | launcher wall (s) | steps/s | round trips per step (router / peer)"
         " | bytes per step |"
     )
     print("|---|---|---|---|---|---|---|")
     for name, runs in (("no logger", plain), ("logger recording", recorded)):
-        stepping = [run["stepping_s"] for run in runs]
-        wall = [run["wall_s"] for run in runs]
-        rate = [run["steps_per_s"] for run in runs]
-        trips = [1e6 / r / rtt["median_us"] for r in rate]
-        peer_trips = [1e6 / r / peer["median_us"] for r in rate]
-        print(
-            f"| {name} | {runs[0]['steps']} | {median(stepping):.1f} ({min(stepping):.1f} – {max(stepping):.1f}) | "
-            f"{median(wall):.1f} ({min(wall):.1f} – {max(wall):.1f}) | {median(rate):.0f} | "
-            f"{median(trips):.1f} / {median(peer_trips):.1f} | "
-            f"{median([run['bus_bytes_per_step'] for run in runs]):,.0f} |"
-        )
+        print(table_row(name, runs, rtt, peer))
     ratios = [
         with_logger["steps_per_s"] / without["steps_per_s"]
         for without, with_logger in zip(plain, recorded, strict=True)
     ]
     print(
-        f"\nwith the logger: {100 * median(ratios):.0f} % of the step rate without it (median of {args.repeats} "
+        f"\nwith the logger: {100 * median(ratios):.0f} % of the step rate without it (median of {repeats} "
         f"interleaved pairs; {100 * min(ratios):.0f} – {100 * max(ratios):.0f} %); recording "
         f"{median([run['recording_bytes_per_1000_steps'] for run in recorded]) / 1e6:.2f} MB per 1,000 steps"
     )
-    if not args.skip_30:
-        row = run_team(30, None)
-        print(
-            f"\nN = 30 (30 agent processes), paper scenario: {row['steps']} steps, {row['stepping_s']:.1f} s of "
-            f"stepping, {row['wall_s']:.1f} s wall, {row['steps_per_s']:.0f} steps/s, "
-            f"{row['bus_bytes_per_step']:,.0f} bytes through the coordinator per step"
-        )
+
+
+def table_row(name: str, runs: list[dict[str, float]], rtt: dict[str, float], peer: dict[str, float]) -> str:
+    """One variant's line of the Markdown table: medians, with the range of the times."""
+    stepping = [run["stepping_s"] for run in runs]
+    wall = [run["wall_s"] for run in runs]
+    rate = [run["steps_per_s"] for run in runs]
+    trips = [1e6 / r / rtt["median_us"] for r in rate]
+    peer_trips = [1e6 / r / peer["median_us"] for r in rate]
+    return (
+        f"| {name} | {runs[0]['steps']} | {median(stepping):.1f} ({min(stepping):.1f} – {max(stepping):.1f}) | "
+        f"{median(wall):.1f} ({min(wall):.1f} – {max(wall):.1f}) | {median(rate):.0f} | "
+        f"{median(trips):.1f} / {median(peer_trips):.1f} | "
+        f"{median([run['bus_bytes_per_step'] for run in runs]):,.0f} |"
+    )
+
+
+def team_of_30() -> None:
+    row = run_team(30, None)
+    print(
+        f"\nN = 30 (30 agent processes), paper scenario: {row['steps']} steps, {row['stepping_s']:.1f} s of "
+        f"stepping, {row['wall_s']:.1f} s wall, {row['steps_per_s']:.0f} steps/s, "
+        f"{row['bus_bytes_per_step']:,.0f} bytes through the coordinator per step"
+    )
 
 
 if __name__ == "__main__":

@@ -29,7 +29,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from logger.process import LoggerOptions, run_logger
+    from logger.process import run_logger
+    from logger.team_logger import LoggerOptions
     from protocol.session import config_from_arguments
     from runtime.lifecycle import StopFlag, setup_logging
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import zlib
+from collections.abc import Callable
 from typing import Any
 
 import msgpack
@@ -163,77 +164,102 @@ def _decode_objectives(body: dict[str, Any], limits: Limits) -> Objectives:
     return Objectives(step, tuple(members), np.array(targets).reshape(-1, 2), np.array(blobs).reshape(-1, 2), labels)
 
 
+def _decode_step(body: dict[str, Any], limits: Limits) -> AgentStep:
+    delta = _decode_delta(_submap(body, "delta"), limits)
+    state = _decode_state(_submap(body, "state"), limits)
+    if delta.agent != state.agent or delta.seq != state.step:
+        raise ProtocolError("out-of-range", "a step's delta and state must be of one agent and one step")
+    return AgentStep(delta, state)
+
+
+def _decode_go(body: dict[str, Any], limits: Limits) -> StepGo:
+    step = _int(body, "step", 0, MAX_STEP)
+    members = _members(body, limits.agents - 1)
+    deltas = [_decode_delta(item, limits) for item in _submaps(body, "deltas", limits.agents)]
+    states = [_decode_state(item, limits) for item in _submaps(body, "states", limits.agents)]
+    if any(delta.seq != step - 1 for delta in deltas) or any(state.step != step - 1 for state in states):
+        raise ProtocolError("out-of-range", "a go for step k carries deltas and states of step k-1 only")
+    if len({delta.agent for delta in deltas}) != len(deltas) or len({s.agent for s in states}) != len(states):
+        raise ProtocolError("out-of-range", "one delta and one state per agent")
+    raw_objectives = body.get("objectives")
+    if raw_objectives is not None and not isinstance(raw_objectives, dict):
+        raise ProtocolError("bad-field", "objectives must be a map or nil")
+    objectives = None if raw_objectives is None else _decode_objectives(raw_objectives, limits)
+    return StepGo(step, tuple(members), tuple(deltas), objectives, tuple(states))
+
+
+def _decode_control(body: dict[str, Any], limits: Limits) -> RunControl:
+    control_kind = body.get("kind")
+    if control_kind not in RUN_CONTROL_KINDS:
+        raise ProtocolError("bad-field", f"kind must be one of {RUN_CONTROL_KINDS}")
+    completed = body.get("completed")
+    reason = body.get("reason")
+    if not isinstance(completed, bool) or not isinstance(reason, str) or len(reason) > 1000:
+        raise ProtocolError("bad-field", "completed must be a bool and reason a short string")
+    return RunControl(control_kind, _int(body, "step", 0, MAX_STEP), completed, _finite(body.get("e_d"), "e_d"), reason)
+
+
+def _applied(body: dict[str, Any], last_agent: int) -> dict[int, tuple[int, tuple[int, ...]]]:
+    """A snapshot's applied sequences: per agent, the contiguous sequence and the extras after it."""
+    applied_raw = body.get("applied")
+    if not isinstance(applied_raw, list):
+        raise ProtocolError("bad-field", "applied must be a list")
+    applied: dict[int, tuple[int, tuple[int, ...]]] = {}
+    for entry in applied_raw:
+        if not (isinstance(entry, list) and len(entry) == 3 and isinstance(entry[2], list)):
+            raise ProtocolError("bad-shape", "applied entries are [agent, seq, extras]")
+        agent = _int({"a": entry[0]}, "a", 0, last_agent)
+        seq = _int({"s": entry[1]}, "s", -1, MAX_STEP)
+        extras = tuple(_int({"e": item}, "e", seq + 1, MAX_STEP) for item in entry[2])
+        applied[agent] = (seq, extras)
+    return applied
+
+
+def _poses(body: dict[str, Any], last_agent: int) -> dict[int, Pose]:
+    """A snapshot's last known pose per agent."""
+    poses: dict[int, Pose] = {}
+    poses_raw = body.get("poses", [])
+    if not isinstance(poses_raw, list):
+        raise ProtocolError("bad-field", "poses must be a list")
+    for entry in poses_raw:
+        if not (isinstance(entry, list) and len(entry) == 4):
+            raise ProtocolError("bad-shape", "pose entries are [agent, x, y, theta]")
+        agent = _int({"a": entry[0]}, "a", 0, last_agent)
+        x, y, theta = (_finite(value, "pose") for value in entry[1:])
+        poses[agent] = (x, y, theta)
+    return poses
+
+
+def _decode_snapshot(body: dict[str, Any], limits: Limits) -> Snapshot:
+    rows = _int(body, "rows", limits.rows, limits.rows)
+    cols = _int(body, "cols", limits.cols, limits.cols)
+    raw = _inflate(body.get("map"), 8 * rows * cols, "map")
+    coverage = np.frombuffer(raw, dtype="<i8").reshape(rows, cols).astype(np.int64)
+    if (coverage < 0).any():
+        raise ProtocolError("negative-delta", "map cells must be non-negative")
+    applied = _applied(body, limits.agents - 1)
+    return Snapshot(coverage, applied, _poses(body, limits.agents - 1))
+
+
+_DECODERS: dict[str, Callable[[dict[str, Any], Limits], Message]] = {
+    "delta": _decode_delta,
+    "state": _decode_state,
+    "step": _decode_step,
+    "objectives": _decode_objectives,
+    "go": _decode_go,
+    "control": _decode_control,
+    "snapshot": _decode_snapshot,
+}
+"""Each message type's decoder: it validates the body and builds the message, or raises ProtocolError."""
+
+
 def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Message:
     """Decode and validate one payload; raise ProtocolError (with ``.reason``) if it is not acceptable."""
     body = _header(payload)
     kind = body.get("type")
     if expected is not None and kind != expected:
         raise ProtocolError("wrong-type", f"expected {expected}, got {kind!r}")
-    last_agent = limits.agents - 1
-    if kind == "delta":
-        return _decode_delta(body, limits)
-    if kind == "state":
-        return _decode_state(body, limits)
-    if kind == "step":
-        delta = _decode_delta(_submap(body, "delta"), limits)
-        state = _decode_state(_submap(body, "state"), limits)
-        if delta.agent != state.agent or delta.seq != state.step:
-            raise ProtocolError("out-of-range", "a step's delta and state must be of one agent and one step")
-        return AgentStep(delta, state)
-    if kind == "objectives":
-        return _decode_objectives(body, limits)
-    if kind == "go":
-        step = _int(body, "step", 0, MAX_STEP)
-        members = _members(body, last_agent)
-        deltas = [_decode_delta(item, limits) for item in _submaps(body, "deltas", limits.agents)]
-        states = [_decode_state(item, limits) for item in _submaps(body, "states", limits.agents)]
-        if any(delta.seq != step - 1 for delta in deltas) or any(state.step != step - 1 for state in states):
-            raise ProtocolError("out-of-range", "a go for step k carries deltas and states of step k-1 only")
-        if len({delta.agent for delta in deltas}) != len(deltas) or len({s.agent for s in states}) != len(states):
-            raise ProtocolError("out-of-range", "one delta and one state per agent")
-        raw_objectives = body.get("objectives")
-        if raw_objectives is not None and not isinstance(raw_objectives, dict):
-            raise ProtocolError("bad-field", "objectives must be a map or nil")
-        objectives = None if raw_objectives is None else _decode_objectives(raw_objectives, limits)
-        return StepGo(step, tuple(members), tuple(deltas), objectives, tuple(states))
-    if kind == "control":
-        control_kind = body.get("kind")
-        if control_kind not in RUN_CONTROL_KINDS:
-            raise ProtocolError("bad-field", f"kind must be one of {RUN_CONTROL_KINDS}")
-        completed = body.get("completed")
-        reason = body.get("reason")
-        if not isinstance(completed, bool) or not isinstance(reason, str) or len(reason) > 1000:
-            raise ProtocolError("bad-field", "completed must be a bool and reason a short string")
-        return RunControl(
-            control_kind, _int(body, "step", 0, MAX_STEP), completed, _finite(body.get("e_d"), "e_d"), reason
-        )
-    if kind == "snapshot":
-        rows = _int(body, "rows", limits.rows, limits.rows)
-        cols = _int(body, "cols", limits.cols, limits.cols)
-        raw = _inflate(body.get("map"), 8 * rows * cols, "map")
-        coverage = np.frombuffer(raw, dtype="<i8").reshape(rows, cols).astype(np.int64)
-        if (coverage < 0).any():
-            raise ProtocolError("negative-delta", "map cells must be non-negative")
-        applied_raw = body.get("applied")
-        if not isinstance(applied_raw, list):
-            raise ProtocolError("bad-field", "applied must be a list")
-        applied: dict[int, tuple[int, tuple[int, ...]]] = {}
-        for entry in applied_raw:
-            if not (isinstance(entry, list) and len(entry) == 3 and isinstance(entry[2], list)):
-                raise ProtocolError("bad-shape", "applied entries are [agent, seq, extras]")
-            agent = _int({"a": entry[0]}, "a", 0, last_agent)
-            seq = _int({"s": entry[1]}, "s", -1, MAX_STEP)
-            extras = tuple(_int({"e": item}, "e", seq + 1, MAX_STEP) for item in entry[2])
-            applied[agent] = (seq, extras)
-        poses: dict[int, Pose] = {}
-        poses_raw = body.get("poses", [])
-        if not isinstance(poses_raw, list):
-            raise ProtocolError("bad-field", "poses must be a list")
-        for entry in poses_raw:
-            if not (isinstance(entry, list) and len(entry) == 4):
-                raise ProtocolError("bad-shape", "pose entries are [agent, x, y, theta]")
-            agent = _int({"a": entry[0]}, "a", 0, last_agent)
-            x, y, theta = (_finite(value, "pose") for value in entry[1:])
-            poses[agent] = (x, y, theta)
-        return Snapshot(coverage, applied, poses)
-    raise ProtocolError("unknown-type", repr(kind)[:40])
+    decoder = _DECODERS.get(kind) if isinstance(kind, str) else None
+    if decoder is None:
+        raise ProtocolError("unknown-type", repr(kind)[:40])
+    return decoder(body, limits)
