@@ -88,16 +88,18 @@ def reproduce(
     tasks = [base.with_overrides(agents=n, seed=seed + r, controller="paper") for n in teams for r in range(runs)]
     # Biggest jobs first (one agent runs longest) keeps the pool busy to the end.
     tasks.sort(key=lambda scenario: scenario.agents)
-    outcomes: dict[int, list[tuple[bool, float, float]]] = {n: [] for n in teams}
+    outcomes: dict[int, list[tuple[int, bool, float, float]]] = {n: [] for n in teams}
     workers = workers or os.cpu_count() or 1
     with ProcessPoolExecutor(max_workers=workers) as pool:
         futures = [pool.submit(_one_run, task) for task in tasks]
         for future in tqdm(as_completed(futures), total=len(futures), desc="reproduction runs", unit="run"):
-            agents, _, completed, time, path = future.result()
-            outcomes[agents].append((completed, time, path))
+            agents, run_seed, completed, time, path = future.result()
+            outcomes[agents].append((run_seed, completed, time, path))
+    for results in outcomes.values():
+        results.sort()  # by seed: the means must not depend on which run finished first
     rows = []
     for n in teams:
-        done = [(time, path) for completed, time, path in outcomes[n] if completed]
+        done = [(time, path) for _, completed, time, path in outcomes[n] if completed]
         times = np.array([time for time, _ in done])
         paths = np.array([path for _, path in done])
         ratios = times / optimum_time(area, base.lambda_star, ability, n)
