@@ -19,7 +19,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from agents.process import AgentOptions, run_agent
+    from agents.node import AgentOptions
+    from agents.process import run_agent
     from protocol.session import config_from_arguments
     from runtime.lifecycle import StopFlag, setup_logging
 

@@ -1,0 +1,247 @@
+"""One agent's decisions between messages: its replica of the map, the gos and objectives it has
+received, who is in the team, and the control step itself. No Zenoh session: :mod:`agents.process`
+opens one, feeds this class what arrives and publishes what it returns.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+from agents.robot import Robot, SimulatedUnicycle
+from model.coverage_map import load_kernels as load_map_kernels
+from model.parameters import initial_poses, law_parameters
+from model.scenario import Scenario
+from model.step import LawParameters, decide_and_sense, load_kernels
+from protocol.inbox import Inbox, Membership, Received
+from protocol.keys import TeamKeys
+from protocol.messages import AgentState, AgentStep, Limits, MapDelta, Objectives, Pose, RunControl, Snapshot, StepGo
+from protocol.recovery import Relay
+from protocol.replica import MapReplica
+
+log = logging.getLogger("anicov.agent")
+
+
+@dataclass
+class AgentOptions:
+    team: str
+    agent: int
+    clock: str = "lockstep"
+    speed: float = 1.0
+    drop_rate: float = 0.0
+    counts_file: str | None = None
+
+
+class AgentNode:
+    """The state of one agent process between messages."""
+
+    def __init__(self, scenario: Scenario, options: AgentOptions, robot: Robot | None = None) -> None:
+        self.scenario = scenario
+        self.options = options
+        self.keys = TeamKeys(options.team)
+        rows, cols = scenario.grid_shape
+        self.limits = Limits(rows, cols, scenario.agents)
+        self.replica = MapReplica(rows, cols, scenario.cell, scenario.lambda_star)
+        self.law: LawParameters = law_parameters(scenario, self.replica.map)
+        self.robot = robot or SimulatedUnicycle(tuple(initial_poses(scenario)[options.agent]), self.law)
+        self.inbox = Inbox(self.limits, options.drop_rate, seed=1000 + options.agent)
+        self.step = 0
+        self.objective: tuple[float, float] | None = None
+        self.started = False  # the coordinator has sent the first go or objectives
+        self.gos: dict[int, StepGo] = {}  # lockstep: gos received for steps not yet taken
+        self.last_go = -1  # lockstep: the step of the last go applied
+        self.members_seen: set[int] = set()  # lockstep: the members of the last go applied
+        self.rejoining = False  # lockstep: restarted, waiting for a go that lists this agent again
+        self.finished: RunControl | None = None
+        self.bytes_sent = 0
+        self.relay = Relay(self.keys.agent_relay(options.agent))  # realtime: teammates' steps, for when one dies
+        self.teammates: set[int] = set()  # alive, by their liveliness tokens
+        self.teammates_left: list[int] = []
+
+    # ------------------------------------------------------------ messages
+
+    def handle(self, item: Received | Membership) -> None:
+        if isinstance(item, Membership):
+            self.note_teammate(item)
+            return
+        message = item.message
+        if isinstance(message, AgentStep):  # realtime: teammates' deltas, applied as they come
+            if message.agent != self.options.agent:
+                self.replica.apply(message.delta)
+                self.relay.add(message.agent, message.delta.seq, item.payload)
+        elif isinstance(message, StepGo):
+            if message.step >= self.step:
+                self.gos[message.step] = message
+            self.started = True
+        elif isinstance(message, Objectives):
+            self.take_targets(message)
+            self.started = True
+        elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
+            self.finished = message
+
+    def handle_queued(self) -> None:
+        """Everything already in the inbox, without waiting for more."""
+        while (item := self.inbox.get(timeout=0)) is not None:
+            self.handle(item)
+
+    def note_teammate(self, change: Membership) -> None:
+        """A teammate's liveliness token came or went. The coordinator replans for the team; a robot
+        logs it (a dead teammate's lost deltas then come from the relays, see protocol.recovery.fill_gaps)."""
+        if change.agent == self.options.agent:
+            return
+        if change.alive:
+            if change.agent in self.teammates_left:
+                log.info("agent %d: teammate %d is back", self.options.agent, change.agent)
+            self.teammates.add(change.agent)
+        elif change.agent in self.teammates:
+            self.teammates.discard(change.agent)
+            if self.finished is not None:
+                return  # the run is over: teammates leave as they finish
+            self.teammates_left.append(change.agent)
+            log.warning("agent %d: teammate %d left (its liveliness token is gone)", self.options.agent, change.agent)
+
+    def apply_remaining_gos(self) -> None:
+        """At the end of a run: the last go completes the map even if the end arrived first."""
+        for step in sorted(self.gos):
+            self.apply_teammates(self.gos.pop(step).deltas)
+
+    def apply_teammates(self, deltas: tuple[MapDelta, ...]) -> None:
+        """A go's deltas, but our own: that one entered the replica when we made it."""
+        for delta in deltas:
+            if delta.agent != self.options.agent:
+                self.replica.apply(delta)
+
+    def take_targets(self, objectives: Objectives) -> None:
+        target = objectives.target_of(self.options.agent)
+        if target is not None:
+            self.objective = target
+
+    def ready_for_step(self) -> bool:
+        """Lockstep: the go for this step is here. Its deltas (every member's previous step) enter
+        the replica, which then holds exactly Λ_k, and its objectives, if any, are taken."""
+        go = self.gos.pop(self.step, None)
+        if go is None:
+            return False
+        self.last_go = go.step
+        if self.members_seen:
+            for returning in set(go.members) - self.members_seen:
+                self.replica.skip(returning, go.step - 1)  # the steps it was away will never come
+        self.members_seen = set(go.members)
+        self.apply_teammates(go.deltas)
+        if go.objectives is not None:
+            self.take_targets(go.objectives)
+        if self.replica.map.complete or self.step >= self.scenario.max_steps:
+            return False  # the last go only completes the map: wait for the end of the run
+        if self.objective is None:
+            raise RuntimeError(f"agent {self.options.agent} has no objective at step {self.step}")
+        return True
+
+    def admitted(self) -> bool:
+        """The team has taken this agent in: any go (or objectives) at the start; after a restart in
+        lockstep, a go that lists it again (the coordinator admits a returning robot at a step boundary)."""
+        if not self.rejoining:
+            return self.started
+        listed = [step for step, go in self.gos.items() if self.options.agent in go.members]
+        if listed:
+            self.join_at(min(listed))
+        return not self.rejoining
+
+    def join_at(self, step: int) -> None:
+        """A returning robot's first go. The gos before it only complete the map (each delta once, over
+        the snapshot); the steps it missed will never come."""
+        for earlier in sorted(s for s in self.gos if s < step):
+            self.apply_teammates(self.gos.pop(earlier).deltas)
+        self.replica.skip(self.options.agent, step - 1)
+        self.members_seen = set(self.gos[step].members)
+        self.step = step
+        self.rejoining = False
+
+    def waiting_for(self) -> str:
+        """What a lockstep step is waiting on, for the log."""
+        return f"the coordinator's go for step {self.step}"
+
+    def lost_last_go(self) -> bool:
+        """Lockstep, at the end of a run: the last go (every member's last delta) has not arrived,
+        though the end of the run has (so it was lost, or is late)."""
+        final = self.finished.step if self.finished is not None and self.finished.kind == "done" else -1
+        return self.last_go < final and final not in self.gos
+
+    def others(self) -> list[int]:
+        """Every other agent of the team, alive or not."""
+        return [agent for agent in range(self.scenario.agents) if agent != self.options.agent]
+
+    # ------------------------------------------------------------ control
+
+    def control_step(self) -> tuple[MapDelta, AgentState]:
+        """Decide, sense and move for the current step (eq. 1–16); return what to publish."""
+        assert self.objective is not None
+        pose = self.robot.pose()
+        v, omega, e_omega, row0, col0, ticks = decide_and_sense(
+            self.replica.map.coverage, *pose, self.objective[0], self.objective[1], self.law
+        )
+        delta = MapDelta(self.options.agent, self.step, row0, col0, ticks)
+        self.replica.apply(delta)
+        next_pose = self.robot.command(v, omega)
+        state = AgentState(self.options.agent, self.step, pose, v, omega, e_omega, next_pose)
+        self.step += 1
+        return delta, state
+
+    def load_kernels(self) -> None:
+        """numba's kernels loaded while the team gathers (see model.step.load_kernels)."""
+        load_kernels(self.replica.map.coverage, self.robot.pose(), self.law)
+        load_map_kernels()
+
+    def hello(self) -> AgentState:
+        pose = self.robot.pose()
+        return AgentState(self.options.agent, -1, pose, 0.0, 0.0, 0.0, pose)
+
+    # ------------------------------------------------------------ restart
+
+    def load_snapshot(self, snapshot: Snapshot) -> int | None:
+        """A restarted robot: if the coordinator's snapshot knows this agent, resume where it stopped.
+
+        The map and the applied sequences come from the snapshot (deltas arriving
+        meanwhile are applied once). The last steps before the crash may have
+        reached teammates but not the coordinator: the process fetches them from
+        the relays, from the sequence returned here, into the inbox, and
+        :meth:`finish_resume` takes them, so that no sequence is ever used for
+        two different deltas. None: the snapshot knows nothing of ours (a fresh run).
+        """
+        own = snapshot.applied.get(self.options.agent)
+        if own is None:
+            return None
+        self.replica.load(snapshot)
+        contiguous, extras = own
+        self.step = max((contiguous, *extras)) + 1
+        return contiguous + 1
+
+    def finish_resume(self, pose: Pose | None) -> None:
+        """After :meth:`load_snapshot` and the relays' answers: the step continues after this agent's
+        last delta anyone holds, and the simulated robot restarts from its last known pose (``pose``,
+        the snapshot's, unless a relayed step is later; a real robot reads its pose from its
+        localisation instead). Anything else queued meanwhile is handled as usual."""
+        me = self.options.agent
+        while (item := self.inbox.get(timeout=0)) is not None:
+            if isinstance(item, Received) and isinstance(item.message, AgentStep) and item.message.agent == me:
+                self.replica.apply(item.message.delta)
+                if item.message.state.step >= self.step:
+                    self.step = item.message.state.step + 1
+                    pose = item.message.state.next_pose
+            else:
+                self.handle(item)
+        if pose is not None and isinstance(self.robot, SimulatedUnicycle):
+            self.robot = SimulatedUnicycle(pose, self.law)
+
+    # ------------------------------------------------------------ end
+
+    def counts(self) -> dict[str, object]:
+        """What this agent reports at exit (tests compare them across processes)."""
+        return (
+            self.inbox.counts()
+            | self.replica.counts()
+            | {
+                "steps": self.step,
+                "bytes_sent": self.bytes_sent,
+                "teammates_left": self.teammates_left,
+            }
+        )
