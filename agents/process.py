@@ -30,15 +30,13 @@ import zenoh
 from agents.node import AgentNode, AgentOptions
 from model.scenario import Scenario
 from protocol.messages import AgentState, AgentStep, MapDelta, encode
-from protocol.recovery import GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
+from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
 from protocol.session import open_session, team_publisher
 from runtime.lifecycle import EXIT_FAILED, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 from runtime.rundir import write_counts
 
 log = logging.getLogger("anicov.agent")
 
-END_ONLY = 2**60
-"""A history query from this step returns no step, only the end of the run once it is known."""
 HELLO_PERIOD = 0.2
 """Seconds between repeated hellos until the coordinator's first go arrives."""
 

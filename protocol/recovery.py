@@ -24,6 +24,8 @@ from protocol.replica import MapReplica
 log = logging.getLogger("anicov.bus")
 
 
+END_ONLY = 2**60
+"""A history query from this step returns no step, only the end of the run once it is known."""
 MAX_STEPS_ASKED = 2000
 """The most single steps one history query may name (a selector must stay a reasonable size)."""
 
