@@ -39,9 +39,8 @@ class AgentNode:
         self.scenario = scenario
         self.options = options
         self.keys = TeamKeys(options.team)
-        rows, cols = scenario.grid_shape
-        self.limits = Limits(rows, cols, scenario.agents)
-        self.replica = MapReplica(rows, cols, scenario.cell, scenario.lambda_star)
+        self.limits = Limits.of(scenario)
+        self.replica = MapReplica.of(scenario)
         self.law: LawParameters = law_parameters(scenario, self.replica.map)
         self.robot = robot or SimulatedUnicycle(tuple(initial_poses(scenario)[options.agent]), self.law)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=1000 + options.agent)

@@ -186,7 +186,7 @@ class ControlWatch:
     def __init__(self, scenario: Scenario) -> None:
         from protocol.messages import Limits
 
-        self.limits = Limits(*scenario.grid_shape, scenario.agents)
+        self.limits = Limits.of(scenario)
         self.latest: dict[str, RunControl] = {}
 
     def on_sample(self, sample: zenoh.Sample) -> None:

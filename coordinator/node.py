@@ -42,9 +42,8 @@ class Coordinator:
         self.scenario = scenario
         self.options = options
         self.keys = TeamKeys(options.team)
-        rows, cols = scenario.grid_shape
-        self.limits = Limits(rows, cols, scenario.agents)
-        self.replica = MapReplica(rows, cols, scenario.cell, scenario.lambda_star)
+        self.limits = Limits.of(scenario)
+        self.replica = MapReplica.of(scenario)
         self.planner = Planner(scenario)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=999)
         self.alive: set[int] = set()

@@ -36,9 +36,8 @@ class LoggerOptions:
 class TeamLogger:
     def __init__(self, scenario: Scenario, options: LoggerOptions) -> None:
         self.scenario = scenario
-        rows, cols = scenario.grid_shape
-        self.limits = Limits(rows, cols, scenario.agents)
-        self.replica = MapReplica(rows, cols, scenario.cell, scenario.lambda_star)
+        self.limits = Limits.of(scenario)
+        self.replica = MapReplica.of(scenario)
         self.inbox = Inbox(self.limits, defer_decoding=True)
         self.recorder = RunRecorder(
             scenario,

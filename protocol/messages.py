@@ -25,6 +25,8 @@ from typing import Any
 import msgpack
 import numpy as np
 
+from model.scenario import Scenario
+
 PROTOCOL_VERSION = 1
 MAX_PAYLOAD_BYTES = 8 * 1024 * 1024
 """Larger payloads are rejected before decoding (a snapshot of a 1000×1000 map compresses far below)."""
@@ -45,6 +47,11 @@ class Limits:
     rows: int
     cols: int
     agents: int
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> Limits:
+        """The limits of a scenario's team: its grid and its size."""
+        return cls(*scenario.grid_shape, scenario.agents)
 
 
 Pose = tuple[float, float, float]

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from model.coverage_map import CoverageMap
+from model.scenario import Scenario
 from protocol.messages import MapDelta, Snapshot
 
 
@@ -48,6 +49,11 @@ class MapReplica:
         self.duplicates = 0
         # A snapshot may be served from Zenoh's thread while the main thread applies deltas.
         self._lock = threading.Lock()
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> MapReplica:
+        """An empty replica of a scenario's map."""
+        return cls(*scenario.grid_shape, scenario.cell, scenario.lambda_star)
 
     def has(self, agent: int, seq: int) -> bool:
         """Whether (agent, seq) is in the map; every agent trivially has 'step −1' (nothing)."""
