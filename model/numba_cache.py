@@ -20,6 +20,8 @@ KERNEL_SOURCES = (
     "model/control.py",
     "model/dynamics.py",
     "model/step.py",
+    "model/visibility.py",
+    "model/clearance.py",
     "model/fixed_point.py",
     "model/coverage_map.py",
     "anicov/engine.py",
