@@ -57,3 +57,18 @@ def step_or_stay(
     if disk_is_free(occupied, next_x, next_y, radius, cell, bounded):
         return next_x, next_y, next_theta
     return x, y, next_theta
+
+
+@njit(cache=True)
+def swept_disk_is_free(
+    occupied: np.ndarray, x0: float, y0: float, x1: float, y1: float, radius: float, cell: float, bounded: bool
+) -> bool:
+    """Whether the disk stays free along the segment (x0, y0) → (x1, y1), tested every quarter of the
+    smaller of the cell and the radius (a straight drive toward a waypoint, in steps shorter than that)."""
+    spacing = 0.25 * min(cell, radius) if radius > 0.0 else 0.25 * cell
+    samples = max(1, math.ceil(math.hypot(x1 - x0, y1 - y0) / spacing))
+    for k in range(1, samples + 1):
+        t = k / samples
+        if not disk_is_free(occupied, x0 + t * (x1 - x0), y0 + t * (y1 - y0), radius, cell, bounded):
+            return False
+    return True

@@ -22,6 +22,7 @@ KERNEL_SOURCES = (
     "model/step.py",
     "model/visibility.py",
     "model/clearance.py",
+    "model/geodesic.py",
     "model/fixed_point.py",
     "model/coverage_map.py",
     "anicov/engine.py",

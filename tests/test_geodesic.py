@@ -1,0 +1,77 @@
+"""model.geodesic: distance fields around walls, and a way to follow them that never stalls at a wall."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from model.clearance import disk_is_free, step_or_stay
+from model.geodesic import descent_waypoint, distance_fields, passable_cells
+
+
+def wall_with_a_gap() -> np.ndarray:
+    """40 × 40 cells of 1: a wall along column 20 from row 0 to row 31; the gap is above it."""
+    occupied = np.zeros((40, 40), dtype=bool)
+    occupied[0:32, 20] = True
+    return occupied
+
+
+def test_in_an_empty_grid_the_field_is_the_octile_distance():
+    passable = np.ones((10, 10), dtype=bool)
+    field = distance_fields(passable, [(2, 3)], 1.0)[0]
+    for row, col in ((2, 3), (2, 9), (9, 3), (7, 8), (0, 0)):
+        d_row, d_col = abs(row - 2), abs(col - 3)
+        assert math.isclose(field[row, col], max(d_row, d_col) + (math.sqrt(2) - 1) * min(d_row, d_col))
+
+
+def test_no_step_cuts_a_walls_corner_and_an_enclosed_room_is_unreachable():
+    occupied = np.zeros((5, 5), dtype=bool)
+    occupied[1, 2] = occupied[2, 1] = True  # (1,1) and (2,2) touch only at a corner of walls
+    field = distance_fields(~occupied, [(1, 1)], 1.0)[0]
+    assert field[2, 2] > math.sqrt(2) + 1e-9
+    room = np.zeros((7, 7), dtype=bool)
+    room[2:5, 2] = room[2:5, 4] = room[2, 2:5] = room[4, 2:5] = True
+    assert np.isinf(distance_fields(~room, [(0, 0)], 1.0)[0][3, 3])
+
+
+def test_the_radius_narrows_the_free_space():
+    occupied = np.zeros((9, 9), dtype=bool)
+    occupied[:, 4] = True
+    occupied[4, 4] = False  # a one-cell doorway
+    assert passable_cells(occupied, 0.4, 1.0, False)[4, 4]
+    assert not passable_cells(occupied, 0.6, 1.0, False)[4, 4]  # the doorway is narrower than the robot
+
+
+def test_with_the_objective_in_sight_the_global_law_is_the_papers():
+    free = np.zeros((40, 40), dtype=bool)
+    field = distance_fields(~free, [(30, 30)], 1.0)[0]
+    assert descent_waypoint(field, ~free, free, 5.0, 7.0, 30.5, 30.5, 1.0, 20, 0.5, True) == (
+        math.hypot(25.5, 23.5),
+        30.5,
+        30.5,
+    )
+
+
+def test_following_the_waypoints_gets_round_the_wall_where_heading_straight_stalls():
+    occupied, radius = wall_with_a_gap(), 0.5
+    goal = (30.5, 5.5)
+    passable = passable_cells(occupied, radius, 1.0, True)
+    field = distance_fields(passable, [(5, 30)], 1.0)[0]
+
+    def drive(aim_at_waypoints: bool) -> float:
+        x, y, theta = 5.5, 5.5, 0.0
+        for _ in range(1500):
+            target = (
+                descent_waypoint(field, passable, occupied, x, y, *goal, 1.0, 20, radius, True)[1:]
+                if aim_at_waypoints
+                else goal
+            )
+            heading = math.atan2(target[1] - y, target[0] - x)
+            turn = math.remainder(heading - theta, 2 * math.pi)
+            x, y, theta = step_or_stay(occupied, x, y, theta, 1.0, turn / 0.1, 0.1, radius, 1.0, True)
+            assert disk_is_free(occupied, x, y, radius, 1.0, True)
+        return math.hypot(goal[0] - x, goal[1] - y)
+
+    assert drive(aim_at_waypoints=False) > 10.0  # pressed against the wall
+    assert drive(aim_at_waypoints=True) < 1.0
