@@ -1,6 +1,7 @@
 """The coordinator's state between messages: membership, the open lockstep step, the planner.
 
-Decisions only, no Zenoh: :mod:`coordinator.process` moves messages in and out. It keeps its own
+Decisions only, no Zenoh session: the shell (:mod:`coordinator.process`, with endpoints, startup,
+stepping and ending) moves messages in and out. It keeps its own
 replica of the map, gathers every agent's state, runs the planner (the same
 :class:`model.planning.Planner` as the in-process engine), closes lockstep steps in order, and admits
 robots that return.

@@ -22,6 +22,7 @@ from coordinator.stepping import Stepping
 from model.coverage_map import load_kernels as load_map_kernels
 from model.scenario import Scenario
 from protocol.messages import RunControl
+from protocol.recovery import LossTimer
 from protocol.session import open_session
 from runtime.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 
@@ -33,9 +34,10 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
     parent = os.getppid()
     with open_session(config) as session:
         bus = CoordinatorBus.declare(session, node)
+        loss = LossTimer()  # from here, as before: the first step's patience includes the start
         settle_garbage_collector()
         load_map_kernels()  # while the agents start, not in step 0
-        found = gather_team(bus, options.await_logger, stop)
+        found = gather_team(bus, options.await_logger, stop, parent)
         step = 0
         if found.running:
             step = resume_running_team(bus, found)
@@ -49,7 +51,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             node.members = set(range(scenario.agents))
             log.info("all %d agents present; starting (%s clock)", scenario.agents, options.clock)
             node.take_snapshot(0.0)
-        stepping = Stepping(bus, options.speed, step)
+        stepping = Stepping(bus, options.speed, step, loss=loss)
         stepping.first_message(resumed=bool(found.running))
         turn = stepping.lockstep_turn if options.clock == "lockstep" else stepping.realtime_turn
         while stepping.outcome is None and not stop.stopped:

@@ -15,11 +15,11 @@ from model.run import snapshot_steps
 from protocol.inbox import Received
 from protocol.messages import AgentState, MapDelta, Snapshot
 
-History = list[MapDelta | AgentState]
+HistoryMessages = list[MapDelta | AgentState]
 """Deltas and states read from the agents' histories, in any order."""
 
 
-def by_step(messages: History, members: set[int]) -> tuple[dict[int, list[MapDelta]], dict[int, list[AgentState]]]:
+def by_step(messages: HistoryMessages, members: set[int]) -> tuple[dict[int, list[MapDelta]], dict[int, list[AgentState]]]:
     """The members' deltas by sequence and their states (not hellos) by step."""
     deltas: dict[int, list[MapDelta]] = {}
     states: dict[int, list[AgentState]] = {}
@@ -42,7 +42,7 @@ def resume_step(states: dict[int, list[AgentState]], members: set[int]) -> tuple
     return min(latest.values()), set(latest)
 
 
-def rebuild(node: Coordinator, messages: History, members: set[int], snapshot: Snapshot | None = None) -> int:
+def rebuild(node: Coordinator, messages: HistoryMessages, members: set[int], snapshot: Snapshot | None = None) -> int:
     """Replay the histories into ``node``; return the step to resume at (see the module's docstring)."""
     deltas, states = by_step(messages, members)
     resume, publishing = resume_step(states, members)

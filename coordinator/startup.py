@@ -8,7 +8,6 @@ is (:mod:`coordinator.rebuild`).
 from __future__ import annotations
 
 import logging
-import os
 import time
 from dataclasses import dataclass, field
 
@@ -16,7 +15,7 @@ import zenoh
 
 from coordinator.endpoints import CoordinatorBus
 from coordinator.node import Coordinator
-from coordinator.rebuild import History, rebuild
+from coordinator.rebuild import HistoryMessages, rebuild
 from protocol.inbox import Membership, Received
 from protocol.keys import TeamKeys, agent_of_key
 from protocol.messages import AgentState, AgentStep, Limits, Snapshot
@@ -35,7 +34,7 @@ HISTORY_TIMEOUT = 30.0
 class Gathering:
     """What the wait for the team found: hellos in the node, or steps of a team already running."""
 
-    running: History = field(default_factory=list)
+    running: HistoryMessages = field(default_factory=list)
     logger_ready: bool = True
 
     def take(self, item: Received | Membership, node: Coordinator) -> None:
@@ -46,11 +45,10 @@ class Gathering:
             node.handle(item)
 
 
-def gather_team(bus: CoordinatorBus, await_logger: bool, stop: StopFlag) -> Gathering:
+def gather_team(bus: CoordinatorBus, await_logger: bool, stop: StopFlag, parent: int) -> Gathering:
     """Wait until every agent has said hello (its pose at t_0) and, if asked, a logger listens, unless
     the team is already running (then this coordinator replaces one that died)."""
     node, keys, session = bus.node, bus.keys, bus.session
-    parent = os.getppid()
     found = Gathering(logger_ready=not await_logger)
     deadline = time.monotonic() + START_TIMEOUT
     next_look = 0.0

@@ -27,7 +27,7 @@ from protocol.session import open_session
 from runtime.lifecycle import EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 from runtime.rundir import write_counts
 
-log = logging.getLogger("logger.process")
+log = logging.getLogger("anicov.logger")
 
 FLUSH_PERIOD = 0.5
 """Seconds between sends of the buffered per-step columns."""

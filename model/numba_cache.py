@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -42,10 +43,10 @@ def configure() -> None:
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
     folder = str(kernel_cache_dir())
-    os.environ["NUMBA_CACHE_DIR"] = folder
-    import numba
-
-    numba.config.CACHE_DIR = folder
+    os.environ["NUMBA_CACHE_DIR"] = folder  # numba reads it when it is first imported
+    numba = sys.modules.get("numba")
+    if numba is not None:  # already imported: tell it directly (importing it here would slow every CLI start)
+        numba.config.CACHE_DIR = folder
 
 
 configure()

@@ -1,7 +1,6 @@
 """The team's planning step: Algorithm 1 (objectives from blobs) then Algorithm 2 (assignment).
 
-The in-process engine and the coordinator process (and, with local planning, every agent) call the
-same :class:`Planner`, so the objectives of a run do not depend on where the planning runs.
+The in-process engine and the coordinator process call the same :class:`Planner`, so the objectives of a run do not depend on where the planning runs.
 """
 
 from __future__ import annotations

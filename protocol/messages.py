@@ -1,9 +1,8 @@
 """Message types of the team protocol, encoded with msgpack, versioned and validated.
 
 Every payload is a msgpack map ``{"v": PROTOCOL_VERSION, "type": ..., ...}``.
-Encoding never fails for a well-formed value; decoding checks everything a
-receiver relies on (version, type, field types, shapes, finite numbers, ids in
-range, map windows inside the grid, non-negative deltas) and raises
+Encoding (here) never fails for a well-formed value; decoding
+(:mod:`protocol.decoding`) checks everything a receiver relies on and raises
 :class:`ProtocolError` with a short reason otherwise. Nothing that fails to
 decode may touch a map or a controller.
 

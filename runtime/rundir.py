@@ -84,7 +84,7 @@ def format_summary(summary: dict[str, Any], out_dir: Path | None = None) -> str:
 
 
 def write_counts(path: Path | None, counts: dict[str, object]) -> None:
-    """Persist a process's message counters (read by tests and the launcher's summary)."""
+    """Persist a process's message counters (read by tests and by whoever studies a run)."""
     if path is not None:
         path.write_text(json.dumps(counts, indent=2, sort_keys=True) + "\n", encoding="utf-8")
 
