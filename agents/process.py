@@ -23,7 +23,6 @@ import logging
 import os
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import zenoh
 
@@ -59,7 +58,7 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             run_realtime_steps(bus, scenario.dt / options.speed, stop, parent)
         finish_run(bus, lockstep)
         bus.token.undeclare()
-    write_counts(Path(options.counts_file) if options.counts_file else None, node.counts())
+    write_counts(options.counts_file, node.counts())
     return exit_code(node, stop)
 
 

@@ -22,13 +22,11 @@ from model.coverage_map import CoverageMap
 from model.parameters import initial_poses, law_parameters
 from model.reference import numpy_team_step
 from model.run import TRACE_FIELDS
-from model.scenario import load_scenario
-
-PAPER = Path(__file__).resolve().parent.parent / "scenarios" / "paper.toml"
+from model.scenario import PAPER_SCENARIO, load_scenario
 
 
 def engine_rate(agents: int, steps: int) -> float:
-    scenario = load_scenario(PAPER).with_overrides(agents=agents, seed=1)
+    scenario = load_scenario(PAPER_SCENARIO).with_overrides(agents=agents, seed=1)
     coverage_map = CoverageMap(*scenario.grid_shape, scenario.cell, scenario.lambda_star)
     law = law_parameters(scenario, coverage_map)
     poses = initial_poses(scenario)
@@ -62,7 +60,7 @@ def engine_rate(agents: int, steps: int) -> float:
 
 
 def numpy_rate(agents: int, steps: int) -> float:
-    scenario = load_scenario(PAPER).with_overrides(agents=agents, seed=1)
+    scenario = load_scenario(PAPER_SCENARIO).with_overrides(agents=agents, seed=1)
     coverage_map = CoverageMap(*scenario.grid_shape, scenario.cell, scenario.lambda_star)
     law = law_parameters(scenario, coverage_map)
     poses = initial_poses(scenario)

@@ -40,7 +40,7 @@ def settle_last_deltas(bus: CoordinatorBus, done: bytes | None) -> None:
     on the way, last ones included (see fill_gaps). Lockstep: nothing is in flight, the last go closed
     every step."""
     node = bus.node
-    realtime = node.open_step is None
+    realtime = not node.lockstep
     node.open_step = None
     if realtime:
         node.inbox.drain(0.5, node.handle)

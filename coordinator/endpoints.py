@@ -39,7 +39,7 @@ class CoordinatorBus:
         go = team_publisher(session, keys.go)
         go_history = History(keys.go_history)
         session.declare_queryable(keys.go_history, go_history.serve)
-        if node.options.clock != "lockstep":
+        if not node.lockstep:
             session.declare_queryable(keys.coordinator_relay, node.relay.serve)
         control = team_publisher(session, keys.control)
         status = team_publisher(session, keys.status)

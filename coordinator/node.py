@@ -55,7 +55,8 @@ class Coordinator:
         self.membership_changed = False
         self.targets = np.zeros((0, 2))
         self.bytes_sent = 0
-        self.open_step: int | None = 0 if options.clock == "lockstep" else None
+        self.lockstep = options.clock == "lockstep"
+        self.open_step: int | None = 0 if self.lockstep else None  # lockstep: the step being closed
         self.held_back: list[MapDelta] = []
         self.open_deltas: dict[int, MapDelta] = {}
         self.states_by_step: dict[int, dict[int, AgentState]] = {}  # lockstep: states not yet sent in a go

@@ -53,13 +53,13 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             node.take_snapshot(0.0)
         stepping = Stepping(bus, options.speed, step, loss=loss)
         stepping.first_message(resumed=bool(found.running))
-        turn = stepping.lockstep_turn if options.clock == "lockstep" else stepping.realtime_turn
+        turn = stepping.lockstep_turn if node.lockstep else stepping.realtime_turn
         while stepping.outcome is None and not stop.stopped:
             if parent_is_gone(parent):
                 stop.set()
                 break
             turn()
-            if stepping.outcome is None or options.clock == "lockstep":
+            if stepping.outcome is None or node.lockstep:
                 stepping.status_if_due()
         done = announce_end(bus, stepping)
         settle_last_deltas(bus, done)

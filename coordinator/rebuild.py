@@ -53,7 +53,7 @@ def rebuild(node: Coordinator, messages: HistoryMessages, members: set[int], sna
         if gone and snapshot is not None:
             node.replica.adopt(snapshot, [m for m in messages if isinstance(m, MapDelta)], gone)
             node.log.events.append(f"coverage of agents {sorted(gone)} taken from a member's snapshot")
-        if node.open_step is not None:
+        if node.lockstep:
             node.open_step = resume
         # What lies beyond: the open step's deltas (for the next go) and any later ones.
         for message in messages:
@@ -69,7 +69,6 @@ def replay(
 ) -> None:
     """Steps 0..resume as the lost coordinator lived them: Λ_s, e_D, snapshots, states, and the plans."""
     every = snapshot_steps(node.scenario.dt)
-    lockstep = node.open_step is not None
     for step in range(resume + 1):
         if step > 0:
             for delta in deltas.get(step - 1, []):
@@ -80,7 +79,7 @@ def replay(
         for state in states.get(step, []):
             node.log.record(state)
             node.positions[state.agent] = (state.pose[0], state.pose[1])
-        if lockstep and step % node.scenario.replan_steps == 0:
+        if node.lockstep and step % node.scenario.replan_steps == 0:
             node.plan(step)
         for state in states.get(step, []):
             node.latest_state_step[state.agent] = step

@@ -51,10 +51,10 @@ class Stepping:
     def first_message(self, resumed: bool) -> None:
         """Lockstep: the go of step 0, from the hellos (not after a rebuild); realtime: the first objectives."""
         node = self.bus.node
-        if node.open_step is not None and not resumed:
+        if node.lockstep and not resumed:
             node.closed_states = node.states_by_step.pop(-1, {})  # the hellos: where everyone starts
             self.bus.publish_go(node.go(0, []))
-        elif node.open_step is None:
+        elif not node.lockstep:
             self.bus.publish(self.bus.objectives, node.plan(0))
 
     def lockstep_turn(self) -> None:

@@ -15,7 +15,6 @@ import os
 import time
 from collections.abc import Callable
 from functools import partial
-from pathlib import Path
 
 import zenoh
 
@@ -58,7 +57,7 @@ def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config,
             _load_snapshot(session, keys, node)  # anything lost on the way: the coordinator's map is the reference
         token.undeclare()
     node.finish()
-    write_counts(Path(options.counts_file) if options.counts_file else None, node.inbox.counts())
+    write_counts(options.counts_file, node.inbox.counts())
     return stop.exit_code(EXIT_OK)
 
 

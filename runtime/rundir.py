@@ -83,10 +83,10 @@ def format_summary(summary: dict[str, Any], out_dir: Path | None = None) -> str:
     return "\n".join(lines)
 
 
-def write_counts(path: Path | None, counts: dict[str, object]) -> None:
-    """Persist a process's message counters (read by tests and by whoever studies a run)."""
-    if path is not None:
-        path.write_text(json.dumps(counts, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+def write_counts(path: str | Path | None, counts: dict[str, object]) -> None:
+    """Persist a process's message counters (read by tests and by whoever studies a run); None: nowhere."""
+    if path:
+        Path(path).write_text(json.dumps(counts, indent=2, sort_keys=True) + "\n", encoding="utf-8")
 
 
 def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, object] | None = None) -> dict[str, Any]:
