@@ -267,7 +267,9 @@ def test_a_late_logger_catches_up_from_the_snapshot_and_records_the_full_final_m
     from logger.replay import summarise_recording
     from model.scenario import load_scenario
 
-    config = write_scenario(tmp_path / "s.toml", domain=[60.0, 60.0], agents=3, seed=4)
+    # 8,044 lockstep steps (5-8 s here): long enough that a logger started 0.5 s in, which needs 1.5-2 s
+    # to import and connect, joins mid-run (a 60 x 60 run of 2,366 steps sometimes ended first).
+    config = write_scenario(tmp_path / "s.toml", domain=[100.0, 100.0], agents=3, seed=4)
     team = unique_team()
     port = free_port()
     out = tmp_path / "team"
