@@ -17,7 +17,7 @@ import numpy as np
 
 from coordinator.run_log import RunLog
 from model.planning import Planner
-from model.run import RunResult
+from model.run import RunResult, snapshot_steps
 from model.scenario import Scenario
 from protocol.inbox import Inbox, Membership, Received
 from protocol.keys import TeamKeys
@@ -197,6 +197,16 @@ class Coordinator:
         return all(
             self.replica.has(agent, step) and self.latest_state_step.get(agent, -2) >= step for agent in self.members
         )
+
+    def log_step(self, step: int) -> None:
+        """The replica holds Λ at t_step: log e_D, and a snapshot of Υ every SNAPSHOT_PERIOD."""
+        self.log.errors.append(self.replica.map.domain_error())
+        if step % snapshot_steps(self.scenario.dt) == 0:
+            self.take_snapshot(step * self.scenario.dt)
+
+    def run_is_over(self, step: int) -> bool:
+        """The end of a run at ``step``: the map is complete, max_time is reached, or no member is left."""
+        return self.replica.map.complete or step >= self.scenario.max_steps or not self.members
 
     def take_snapshot(self, time_now: float) -> None:
         """Keep Υ at ``time_now`` (Fig. 6 and the recording)."""

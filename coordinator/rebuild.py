@@ -11,7 +11,6 @@ before the restart left no history: their coverage is adopted from a member's sn
 from __future__ import annotations
 
 from coordinator.node import Coordinator
-from model.run import snapshot_steps
 from protocol.inbox import Received
 from protocol.messages import AgentState, MapDelta, Snapshot
 
@@ -19,7 +18,9 @@ HistoryMessages = list[MapDelta | AgentState]
 """Deltas and states read from the agents' histories, in any order."""
 
 
-def by_step(messages: HistoryMessages, members: set[int]) -> tuple[dict[int, list[MapDelta]], dict[int, list[AgentState]]]:
+def by_step(
+    messages: HistoryMessages, members: set[int]
+) -> tuple[dict[int, list[MapDelta]], dict[int, list[AgentState]]]:
     """The members' deltas by sequence and their states (not hellos) by step."""
     deltas: dict[int, list[MapDelta]] = {}
     states: dict[int, list[AgentState]] = {}
@@ -68,14 +69,13 @@ def replay(
     node: Coordinator, deltas: dict[int, list[MapDelta]], states: dict[int, list[AgentState]], resume: int
 ) -> None:
     """Steps 0..resume as the lost coordinator lived them: Λ_s, e_D, snapshots, states, and the plans."""
-    every = snapshot_steps(node.scenario.dt)
     for step in range(resume + 1):
         if step > 0:
             for delta in deltas.get(step - 1, []):
                 node.replica.apply(delta)
-            node.log.errors.append(node.replica.map.domain_error())
-        if step % every == 0:
-            node.take_snapshot(step * node.scenario.dt)
+            node.log_step(step)
+        else:
+            node.take_snapshot(0.0)  # Υ at t_0, as a coordinator that lived the run kept it
         for state in states.get(step, []):
             node.log.record(state)
             node.positions[state.agent] = (state.pose[0], state.pose[1])

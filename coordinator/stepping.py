@@ -16,7 +16,6 @@ import time
 from dataclasses import dataclass, field
 
 from coordinator.endpoints import CoordinatorBus
-from model.run import snapshot_steps
 from protocol.messages import Objectives, RunControl
 from protocol.recovery import GAP_CHECK_PERIOD, LossTimer, fetch, fill_gaps
 
@@ -46,7 +45,6 @@ class Stepping:
         self.started = self.began - self.step * scenario.dt / self.speed  # realtime: wall-clock time of step 0
         self.next_plan = time.monotonic()
         self.next_gap_check = self.next_plan + GAP_CHECK_PERIOD
-        self.every = snapshot_steps(scenario.dt)
 
     def first_message(self, resumed: bool) -> None:
         """Lockstep: the go of step 0, from the hellos (not after a rebuild); realtime: the first objectives."""
@@ -58,7 +56,7 @@ class Stepping:
             self.bus.publish(self.bus.objectives, node.plan(0))
 
     def lockstep_turn(self) -> None:
-        node, scenario = self.bus.node, self.bus.node.scenario
+        node = self.bus.node
         item = node.inbox.get(timeout=self.loss.patience)
         if item is not None:
             node.handle(item)
@@ -73,10 +71,8 @@ class Stepping:
             # The replica now holds exactly Λ_{k+1}: every delta of steps ≤ k, none later.
             self.step += 1
             self.loss.step_done()
-            node.log.errors.append(node.replica.map.domain_error())
-            if self.step % self.every == 0:
-                node.take_snapshot(self.step * scenario.dt)
-            if node.replica.map.complete or self.step >= scenario.max_steps or not node.members:
+            node.log_step(self.step)
+            if node.run_is_over(self.step):
                 self.outcome = (self.step, node.replica.map.complete, self.step)
                 # The last go only completes every replica; the agents then wait for the end.
                 self.bus.publish_go(node.go(self.step, node.open_next_step(), final=True))
@@ -94,10 +90,8 @@ class Stepping:
             self.next_gap_check = time.monotonic() + GAP_CHECK_PERIOD
         reached = max(node.latest_state_step.values(), default=-1) + 1
         while len(node.log.errors) <= reached:
-            node.log.errors.append(node.replica.map.domain_error())
-            if (len(node.log.errors) - 1) % self.every == 0:
-                node.take_snapshot((len(node.log.errors) - 1) * scenario.dt)
-        if node.replica.map.complete or reached >= scenario.max_steps or not node.members:
+            node.log_step(len(node.log.errors))
+        if node.run_is_over(reached):
             node.log.errors[reached] = node.replica.map.domain_error()  # the map as it ends
             self.outcome = (reached, node.replica.map.complete, reached)
             return
