@@ -24,6 +24,7 @@ KERNEL_SOURCES = (
     "model/visibility.py",
     "model/clearance.py",
     "model/geodesic.py",
+    "model/reachability.py",
     "model/fixed_point.py",
     "model/coverage_map.py",
     "anicov/engine.py",

@@ -1,0 +1,32 @@
+"""model.reachability: an enclosed room and a pocket narrower than the robot cannot be covered."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from model.geodesic import passable_cells
+from model.reachability import coverable_cells, reachable_cells
+from model.terrain import load_occupancy_map, map_on_grid
+from tests.conftest import ROOT
+
+
+def test_a_closed_room_is_unreachable_and_unseen_and_the_rest_of_the_office_is_coverable():
+    occupied = map_on_grid(load_occupancy_map(ROOT / "scenarios" / "maps" / "office.yaml"), 1.0)
+    passable = passable_cells(occupied, 0.5, 1.0, True)
+    coverable = coverable_cells(occupied, passable, [(50, 50)], 20.0, 1.0)
+    assert not coverable[86:99, 86:99].any()  # the store room behind its walls
+    free = ~occupied
+    free[85:99, 85:99] = False
+    assert coverable[free].all()  # every other free cell: the rooms are seen through their doors
+
+
+def test_a_pocket_narrower_than_the_robot_is_not_reachable_but_may_be_seen():
+    occupied = np.zeros((20, 20), dtype=bool)
+    occupied[:, 10] = True
+    occupied[9, 10] = False  # a one-cell gap in a wall
+    thin, wide = passable_cells(occupied, 0.4, 1.0, True), passable_cells(occupied, 0.6, 1.0, True)
+    assert reachable_cells(thin, [(5, 5)], 1.0)[5, 15]  # through the gap
+    assert not reachable_cells(wide, [(5, 5)], 1.0)[5, 15]  # the robot does not fit through
+    seen = coverable_cells(occupied, wide, [(5, 5)], 20.0, 1.0)
+    assert seen[9, 14] and not seen[2, 15]  # through the gap in line, not round the wall
+    assert not seen[occupied].any()
