@@ -56,3 +56,19 @@ def coverable_cells(
 ) -> np.ndarray:
     """Free cells some reachable pose can see (see the module's docstring)."""
     return _seen_from(occupied, reachable_cells(passable, starts, cell), sensing_range, cell)
+
+
+def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) -> np.ndarray:
+    """Each point (K, 2) moved to the centre of the nearest reachable cell, unless its own cell is
+    reachable (then it stays as it is): an objective must lie where a robot can go."""
+    rows, cols = reachable.shape
+    cells = np.argwhere(reachable)
+    if len(cells) == 0:
+        raise ValueError("no reachable cell: nowhere to send the robots")
+    centres = (cells[:, ::-1] + 0.5) * cell  # (x, y) of each reachable cell
+    moved = np.array(points, dtype=np.float64, copy=True).reshape(-1, 2)
+    for k, (x, y) in enumerate(moved):
+        row, col = min(max(int(y // cell), 0), rows - 1), min(max(int(x // cell), 0), cols - 1)
+        if not reachable[row, col]:
+            moved[k] = centres[int(np.argmin(np.hypot(centres[:, 0] - x, centres[:, 1] - y)))]
+    return moved

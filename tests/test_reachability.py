@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from model.geodesic import passable_cells
-from model.reachability import coverable_cells, reachable_cells
+from model.reachability import coverable_cells, nearest_reachable, reachable_cells
 from model.terrain import load_occupancy_map, map_on_grid
 from tests.conftest import ROOT
 
@@ -30,3 +30,13 @@ def test_a_pocket_narrower_than_the_robot_is_not_reachable_but_may_be_seen():
     seen = coverable_cells(occupied, wide, [(5, 5)], 20.0, 1.0)
     assert seen[9, 14] and not seen[2, 15]  # through the gap in line, not round the wall
     assert not seen[occupied].any()
+
+
+def test_an_objective_in_a_wall_or_a_pocket_moves_to_the_nearest_reachable_cell():
+    reachable = np.zeros((10, 10), dtype=bool)
+    reachable[:, :5] = True
+    points = np.array([[2.2, 3.3], [7.5, 4.5], [50.0, 50.0]])
+    moved = nearest_reachable(reachable, points, 1.0)
+    assert moved[0].tolist() == [2.2, 3.3]  # already where a robot can go
+    assert moved[1].tolist() == [4.5, 4.5]  # the nearest reachable cell centre
+    assert moved[2].tolist() == [4.5, 9.5]  # off the grid: clamped, then moved
