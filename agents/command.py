@@ -1,7 +1,7 @@
 """``anicov agent``: its arguments, and the start of one agent process from them.
 
-Light on imports (no numba, Zenoh or numpy): the CLI builds its parser from here; the process itself (Zenoh, numba) loads only
-when the command runs.
+Light on imports: the CLI builds its parser from here; the process itself (Zenoh, numba, numpy) loads
+only when the command runs.
 """
 
 from __future__ import annotations

@@ -34,15 +34,16 @@ class Stepping:
     outcome: Outcome | None = None
     loss: LossTimer = field(default_factory=LossTimer)
     began: float = field(default_factory=time.monotonic)
-    last_news: float = 0.0
     last_status: float = 0.0
-    next_plan: float = 0.0
-    next_gap_check: float = 0.0
+    # Derived from the above when the loop begins:
+    last_news: float = field(init=False)
+    started: float = field(init=False)  # realtime: the wall-clock time of step 0
+    next_plan: float = field(init=False)
+    next_gap_check: float = field(init=False)
 
     def __post_init__(self) -> None:
-        scenario = self.bus.node.scenario
         self.last_news = self.began
-        self.started = self.began - self.step * scenario.dt / self.speed  # realtime: wall-clock time of step 0
+        self.started = self.began - self.step * self.bus.node.scenario.dt / self.speed
         self.next_plan = time.monotonic()
         self.next_gap_check = self.next_plan + GAP_CHECK_PERIOD
 

@@ -28,10 +28,11 @@ from model.visibility import segment_crosses_occupied
 NEIGHBOURS = ((0, 1), (1, 0), (0, -1), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
 
 
+@njit(cache=True)
 def passable_cells(occupied: np.ndarray, radius: float, cell: float, bounded: bool) -> np.ndarray:
     """Cells whose centre can hold the robot's disk."""
     rows, cols = occupied.shape
-    passable = np.zeros((rows, cols), dtype=bool)
+    passable = np.zeros((rows, cols), dtype=np.bool_)
     for row in range(rows):
         for col in range(cols):
             passable[row, col] = disk_is_free(occupied, (col + 0.5) * cell, (row + 0.5) * cell, radius, cell, bounded)
