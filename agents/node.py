@@ -10,9 +10,11 @@ from dataclasses import dataclass
 
 from agents.robot import Robot, SimulatedUnicycle
 from model.coverage_map import load_kernels as load_map_kernels
-from model.parameters import initial_poses, law_parameters
+from model.ground import NO_FIELD
+from model.parameters import law_parameters, starting_poses
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, load_kernels
+from model.world import world_of
 from protocol.inbox import Inbox, Membership, Received
 from protocol.keys import TeamKeys
 from protocol.messages import AgentState, AgentStep, Limits, MapDelta, Objectives, Pose, RunControl, Snapshot, StepGo
@@ -42,7 +44,12 @@ class AgentNode:
         self.limits = Limits.of(scenario)
         self.replica = MapReplica.of(scenario)
         self.law: LawParameters = law_parameters(scenario, self.replica.map)
-        self.robot = robot or SimulatedUnicycle(tuple(initial_poses(scenario)[options.agent]), self.law)
+        self.world = world_of(scenario)
+        self.ground = self.world.ground
+        starts = starting_poses(scenario)
+        # Every robot's last known position, for the line-of-sight test: all start where the seed puts them.
+        self.positions = starts[:, :2].copy()
+        self.robot = robot or SimulatedUnicycle(tuple(starts[options.agent]), self.law, self.ground)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=1000 + options.agent)
         self.step = 0
         self.objective: tuple[float, float] | None = None
@@ -68,6 +75,7 @@ class AgentNode:
             if message.agent != self.options.agent:
                 self.replica.apply(message.delta)
                 self.relay.add(message.agent, message.delta.seq, item.payload)
+                self.note_position(message.state)
         elif isinstance(message, StepGo):
             if message.step >= self.step:
                 self.gos[message.step] = message
@@ -110,6 +118,11 @@ class AgentNode:
             if delta.agent != self.options.agent:
                 self.replica.apply(delta)
 
+    def note_position(self, state: AgentState) -> None:
+        """A teammate's pose at the end of its step (lockstep: every member's, at the start of this step)."""
+        if 0 <= state.agent < len(self.positions) and state.agent != self.options.agent:
+            self.positions[state.agent] = state.next_pose[:2]
+
     def take_targets(self, objectives: Objectives) -> None:
         target = objectives.target_of(self.options.agent)
         if target is not None:
@@ -127,6 +140,8 @@ class AgentNode:
                 self.replica.skip(returning, go.step - 1)  # the steps it was away will never come
         self.members_seen = set(go.members)
         self.apply_teammates(go.deltas)
+        for state in go.states:
+            self.note_position(state)
         if go.objectives is not None:
             self.take_targets(go.objectives)
         if self.replica.map.complete or self.step >= self.scenario.max_steps:
@@ -175,8 +190,11 @@ class AgentNode:
         """Decide, sense and move for the current step (eq. 1–16); return what to publish."""
         assert self.objective is not None
         pose = self.robot.pose()
+        me = self.options.agent
+        self.positions[me] = pose[:2]
+        field = self.world.field(*self.objective) if self.ground.walls else NO_FIELD
         v, omega, e_omega, row0, col0, ticks = decide_and_sense(
-            self.replica.map.coverage, *pose, self.objective[0], self.objective[1], self.law
+            self.replica.map.coverage, *pose, *self.objective, self.law, self.ground, field, self.positions, me
         )
         delta = MapDelta(self.options.agent, self.step, row0, col0, ticks)
         self.replica.apply(delta)
@@ -187,7 +205,7 @@ class AgentNode:
 
     def load_kernels(self) -> None:
         """numba's kernels loaded while the team gathers (see model.step.load_kernels)."""
-        load_kernels(self.replica.map.coverage, self.robot.pose(), self.law)
+        load_kernels(self.replica.map.coverage, self.robot.pose(), self.law, self.ground)
         load_map_kernels()
 
     def hello(self) -> AgentState:
@@ -229,7 +247,7 @@ class AgentNode:
             else:
                 self.handle(item)
         if pose is not None and isinstance(self.robot, SimulatedUnicycle):
-            self.robot = SimulatedUnicycle(pose, self.law)
+            self.robot = SimulatedUnicycle(pose, self.law, self.ground)
 
     # ------------------------------------------------------------ end
 

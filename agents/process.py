@@ -28,10 +28,11 @@ import zenoh
 
 from agents.node import AgentNode, AgentOptions
 from model.scenario import Scenario
+from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_digest, digest_of
 from protocol.messages import AgentState, AgentStep, MapDelta, encode
 from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
 from protocol.session import open_session, team_publisher
-from runtime.lifecycle import EXIT_FAILED, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
+from runtime.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
 from runtime.rundir import write_counts
 
 log = logging.getLogger("anicov.agent")
@@ -50,7 +51,12 @@ def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, s
             # Lockstep: it says hello like a new robot, and the coordinator lists it again from its next go.
             node.rejoining = lockstep
             log.info("agent %d resumes from the coordinator's snapshot after step %d", options.agent, node.step - 1)
-        wait_until_admitted(bus, stop, parent)
+        try:
+            wait_until_admitted(bus, stop, parent)
+        except ScenarioMismatch as error:
+            log.error("agent %d refuses to join: %s", options.agent, error)
+            bus.token.undeclare()
+            return EXIT_USAGE
         log.info("agent %d starts (%s clock)", options.agent, options.clock)
         if lockstep:
             run_lockstep_steps(bus, stop, parent)
@@ -122,11 +128,21 @@ def resume_from_snapshot(session: zenoh.Session, node: AgentNode) -> bool:
 
 
 def wait_until_admitted(bus: Bus, stop: StopFlag, parent: int) -> None:
-    """Wait for the first go, saying hello until the coordinator has heard it."""
+    """Wait for the first go, saying hello until the coordinator has heard it. No hello before the
+    coordinator has said it runs this agent's scenario and map (ScenarioMismatch otherwise)."""
     node = bus.node
     next_hello = 0.0
     hellos = 0
+    mine, agreed = digest_of(node.scenario), False
     while not node.admitted() and node.finished is None and not stop.stopped:
+        if not agreed:
+            theirs = coordinator_digest(bus.session, node.keys, node.limits, timeout=HELLO_PERIOD)
+            if theirs is not None:
+                check_agreement(mine, theirs, node.scenario)
+                agreed = True
+            elif parent_is_gone(parent):
+                break
+            continue
         if time.monotonic() >= next_hello:
             bus.step_publisher.put(encode(node.hello()))
             next_hello = time.monotonic() + HELLO_PERIOD

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Protocol
 
+from model.ground import Ground
 from model.step import LawParameters, move
 from protocol.messages import Pose
 
@@ -25,13 +26,14 @@ class Robot(Protocol):
 class SimulatedUnicycle:
     """A unicycle moved by eq. 1, exactly as the in-process engine moves it."""
 
-    def __init__(self, initial: Pose, law: LawParameters) -> None:
+    def __init__(self, initial: Pose, law: LawParameters, ground: Ground) -> None:
         self._pose = (float(initial[0]), float(initial[1]), float(initial[2]))
         self._law = law
+        self._ground = ground  # walls stop it as they stop the engine's robots
 
     def pose(self) -> Pose:
         return self._pose
 
     def command(self, v: float, omega: float) -> Pose:
-        self._pose = move(*self._pose, v, omega, self._law)
+        self._pose = move(*self._pose, v, omega, self._law, self._ground)
         return self._pose

@@ -20,11 +20,13 @@ from numba import njit
 from numba.typed import List
 
 from model.coverage_map import CoverageMap, add_window
-from model.parameters import initial_poses, law_parameters
+from model.ground import Ground, open_ground
+from model.parameters import coverage_map_of, law_parameters, starting_poses
 from model.planning import Plan, Planner
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack, snapshot_steps
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move, sense_only
+from model.world import World, world_of
 from model.zigzag import zigzag_pilots
 
 
@@ -34,26 +36,30 @@ def advance_team(
     poses: np.ndarray,
     objectives: np.ndarray,
     law: LawParameters,
+    ground: Ground,
+    fields: np.ndarray,
     steps: int,
     uncovered: int,
     deficit: int,
+    total_deficit: int,
     trace: np.ndarray,
     errors: np.ndarray,
 ) -> tuple[int, int, int]:
     """Run up to ``steps`` steps of the paper's law for the whole team; stop early at full coverage.
 
-    Writes the per-step trace (TRACE_FIELDS) and e_D after each step; returns
-    (steps done, uncovered cells, deficit ticks).
+    ``fields[i]``: the distance field of agent i's objective (terrain only). Writes the per-step trace
+    (TRACE_FIELDS) and e_D after each step; returns (steps done, uncovered cells, deficit ticks).
     """
-    rows, cols = coverage.shape
     agents = poses.shape[0]
-    total_deficit = law.target_ticks * rows * cols
+    positions = np.empty((agents, 2))
     for step in range(steps):
+        positions[:, 0] = poses[:, 0]
+        positions[:, 1] = poses[:, 1]
         windows = List()
         for i in range(agents):
             x, y, theta = poses[i, 0], poses[i, 1], poses[i, 2]
             v, omega, e_omega, row0, col0, ticks = decide_and_sense(
-                coverage, x, y, theta, objectives[i, 0], objectives[i, 1], law
+                coverage, x, y, theta, objectives[i, 0], objectives[i, 1], law, ground, fields[i], positions, i
             )
             windows.append((row0, col0, ticks))
             trace[step, i, 0] = x
@@ -68,7 +74,7 @@ def advance_team(
             uncovered -= covered
         for i in range(agents):
             poses[i, 0], poses[i, 1], poses[i, 2] = move(
-                poses[i, 0], poses[i, 1], poses[i, 2], trace[step, i, 3], trace[step, i, 4], law
+                poses[i, 0], poses[i, 1], poses[i, 2], trace[step, i, 3], trace[step, i, 4], law, ground
             )
         errors[step] = deficit / total_deficit
         if uncovered == 0:
@@ -83,12 +89,11 @@ def run_scenario(
     progress: ProgressCallback | None = None,
 ) -> RunResult:
     """Run one team to full coverage or ``max_time`` in this process."""
-    rows, cols = scenario.grid_shape
-    coverage_map = CoverageMap(rows, cols, scenario.cell, scenario.lambda_star)
-    poses = initial_poses(scenario) if poses is None else np.array(poses, dtype=np.float64)
+    coverage_map = coverage_map_of(scenario)
+    poses = starting_poses(scenario) if poses is None else np.array(poses, dtype=np.float64)
     if scenario.controller == "zigzag":
         return _run_zigzag(scenario, coverage_map, poses, record_trace, progress)
-    law = law_parameters(scenario, coverage_map)
+    law, world = law_parameters(scenario, coverage_map), world_of(scenario)
     planner = Planner(scenario)
     block = scenario.replan_steps
     agents = scenario.agents
@@ -111,9 +116,12 @@ def run_scenario(
             poses,
             objectives,
             law,
+            world.ground,
+            objective_fields(world, objectives),
             steps,
             coverage_map.uncovered_cells,
             coverage_map.deficit_ticks,
+            coverage_map.target_ticks * coverage_map.counted_cells,
             scratch_trace,
             scratch_errors,
         )
@@ -133,6 +141,13 @@ def run_scenario(
     result = _finish(scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace)
     result.plans = plans
     return result
+
+
+def objective_fields(world: World, objectives: np.ndarray) -> np.ndarray:
+    """(N, rows, cols): the distance field of each agent's objective; a placeholder where no wall is."""
+    if not world.ground.walls:
+        return np.zeros((len(objectives), 1, 1))
+    return np.stack([world.field(*target) for target in objectives])
 
 
 def _finish(
@@ -184,6 +199,7 @@ def _run_zigzag(
 ) -> RunResult:
     """The zig-zag baseline: each agent flies its lanes; the run lasts until every plan is done."""
     law = law_parameters(scenario, coverage_map)
+    ground, nobody = open_ground(), np.zeros((0, 2))
     pilots = zigzag_pilots(scenario)
     rows_out: list[np.ndarray] = []
     errors = [coverage_map.domain_error()]
@@ -195,11 +211,11 @@ def _run_zigzag(
         for i, pilot in enumerate(pilots):
             v, omega = pilot.velocities(*poses[i])
             row[i] = (*poses[i], v, omega, 0.0)
-        windows = [sense_only(coverage_map.coverage, *poses[i], law) for i in range(scenario.agents)]
+        windows = [sense_only(coverage_map.coverage, *poses[i], law, ground, nobody, i) for i in range(scenario.agents)]
         for window in windows:
             coverage_map.add(*window)
         for i in range(scenario.agents):
-            poses[i] = move(*poses[i], row[i, 3], row[i, 4], law)
+            poses[i] = move(*poses[i], row[i, 3], row[i, 4], law, ground)
         rows_out.append(row)
         errors.append(coverage_map.domain_error())
         step += 1

@@ -157,17 +157,17 @@ def wait_for_exit(children: list[Child], timeout: float) -> None:
             pass
 
 
-def warm_numba_cache() -> None:
+def warm_numba_cache(scenario: Scenario) -> None:
     """Compile (or load) the jitted kernels once here, so N children do not all compile at once."""
-    from model.coverage_map import CoverageMap
     from model.coverage_map import load_kernels as load_map_kernels
-    from model.parameters import law_parameters
-    from model.scenario import Scenario
+    from model.parameters import coverage_map_of, law_parameters, starting_poses
     from model.step import load_kernels
+    from model.world import world_of
 
-    scenario = Scenario()
-    grid = CoverageMap(*scenario.grid_shape, scenario.cell, scenario.lambda_star)
-    load_kernels(grid.coverage, (50.0, 50.0, 0.0), law_parameters(scenario, grid))
+    grid = coverage_map_of(scenario)
+    load_kernels(
+        grid.coverage, tuple(starting_poses(scenario)[0]), law_parameters(scenario, grid), world_of(scenario).ground
+    )
     load_map_kernels()
 
 
@@ -214,7 +214,7 @@ def main(argv: list[str] | None = None) -> int:
     out_dir = Path(args.out or Path("runs") / datetime.now().strftime("%Y%m%d-%H%M%S"))
     logs = out_dir / "logs"
     logs.mkdir(parents=True, exist_ok=True)
-    warm_numba_cache()
+    warm_numba_cache(scenario)
 
     import zenoh
 

@@ -20,10 +20,11 @@ import zenoh
 
 from logger.team_logger import LoggerOptions, TeamLogger
 from model.scenario import Scenario
+from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_digest, digest_of
 from protocol.keys import TeamKeys
 from protocol.recovery import fetch, fetch_snapshot
 from protocol.session import open_session
-from runtime.lifecycle import EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
+from runtime.lifecycle import EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
 from runtime.rundir import write_counts
 
 log = logging.getLogger("anicov.logger")
@@ -44,6 +45,12 @@ def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config,
         # a process's cost is per message, not per byte, and this one is off the critical path.
         lockstep = options.clock == "lockstep"
         _subscribe(session, keys, node, lockstep)
+        try:
+            _await_agreement(session, keys, node, lambda: stop.stopped or parent_is_gone(parent))
+        except ScenarioMismatch as error:
+            log.error("the logger refuses to record: %s", error)
+            node.finish()
+            return EXIT_USAGE
         # The snapshot before the liveliness token: a run started with --await-logger waits for the token,
         # so every go of a fresh run comes after this snapshot (a loaded machine once let a run's first
         # steps into it, and the logger skipped their gos); a late logger starts from the map as it is.
@@ -67,6 +74,16 @@ def _subscribe(session: zenoh.Session, keys: TeamKeys, node: TeamLogger, lockste
     for key in (*traffic, keys.control):
         session.declare_subscriber(key, node.inbox.on_sample)
     session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
+
+
+def _await_agreement(session: zenoh.Session, keys: TeamKeys, node: TeamLogger, stopped: Callable[[], bool]) -> None:
+    """Until the coordinator answers: it must run this logger's scenario and map (ScenarioMismatch)."""
+    mine = digest_of(node.scenario)
+    while not stopped():
+        theirs = coordinator_digest(session, keys, node.limits, timeout=0.2)
+        if theirs is not None:
+            check_agreement(mine, theirs, node.scenario)
+            return
 
 
 def _load_snapshot(session: zenoh.Session, keys: TeamKeys, node: TeamLogger) -> None:

@@ -7,6 +7,8 @@ units with y pointing up (x/cell, rows − y/cell):
 
     world/domain                       LineStrips2D   the domain outline
     world/map/lack_of_coverage         Image (f32)    Υ (eq. 4): white = uncovered, black = covered
+    world/map/occupancy                Image (RGBA)   terrain only: walls (brown), free cells nobody can see (blue)
+    world/map/priority                 Image (f32)    priority maps only: Λ*(x)/Λ*_max (hidden at first)
     world/blobs/segmentation           SegmentationImage  blob π_j of each cell (Alg. 1)
     world/blobs/objectives             Points2D       Ψ (Alg. 1)
     world/agents/<i>/position          Points2D       labelled "agent i"
@@ -34,7 +36,9 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from model.fixed_point import COVERAGE_SCALE
 from model.scenario import Scenario
+from model.world import world_of
 
 APPLICATION_ID = "anicov"
 TRAIL_STEPS = 500
@@ -117,6 +121,7 @@ class RunRecorder:
         width, height = self.scenario.domain
         corners = self.to_view(np.array([0, width, width, 0, 0]), np.array([0, 0, height, height, 0]))
         self.stream.log("world/domain", rr.LineStrips2D([corners], colors=[(80, 80, 255)]), static=True)
+        self._log_terrain()
         lines = [f"- **{key}**: {value}" for key, value in self.scenario.to_dict().items()]
         self.stream.log(
             "run/scenario", rr.TextDocument("\n".join(["# Scenario", *lines]), media_type="text/markdown"), static=True
@@ -124,6 +129,23 @@ class RunRecorder:
         for agent in range(self.scenario.agents):
             for name in ("v", "omega", "e_omega"):
                 self.stream.log(f"agents/{agent}/{name}", rr.SeriesLines(names=f"agent {agent}"), static=True)
+
+    def _log_terrain(self) -> None:
+        """The occupancy map over Υ (its free cells transparent) and the priority map under it."""
+        world = world_of(self.scenario)
+        if not world.open:
+            layers = np.zeros((*world.occupied.shape, 4), dtype=np.uint8)
+            layers[world.occupied] = (115, 70, 25, 255)
+            layers[~world.occupied & ~world.coverable] = (50, 100, 230, 140)
+            self.stream.log(
+                "world/map/occupancy", rr.Image(np.flipud(layers), color_model="RGBA", draw_order=1.0), static=True
+            )
+        if self.scenario.priority_map:
+            target = round(self.scenario.lambda_star * COVERAGE_SCALE)
+            priority = (world.targets / target).astype(np.float32)
+            self.stream.log(
+                "world/map/priority", rr.Image(np.flipud(priority), color_model="L", draw_order=-1.0), static=True
+            )
 
     def wedge(self, x: float, y: float, theta: float) -> np.ndarray:
         """Outline of the camera footprint of eq. 2: apex, arc of radius R over ±F, back to the apex."""

@@ -49,6 +49,29 @@ def global_law(
 
 
 @njit(cache=True)
+def global_law_around_walls(
+    x: float,
+    y: float,
+    waypoint_x: float,
+    waypoint_y: float,
+    distance: float,
+    literal_heading: bool,
+) -> tuple[float, float]:
+    """Eq. 10–11 on a terrain where a straight drive to the objective would hit a wall: the heading toward
+    the waypoint of the shortest free path (:func:`model.geodesic.descent_waypoint`), u_glo from its
+    length ``distance`` without eq. 10's stop at R/2. That stop frames the objective in the wedge, which
+    the way round a wall does not: a robot stopped R/2 away by path would wait there for ever (and one
+    stopping only when the objective is in line of sight, heading for the waypoint, rocks back and
+    forth on that line). Once a straight drive gets there, eq. 10 applies as printed."""
+    u_glo = (2.0 / math.pi) * math.atan(distance)
+    dx = waypoint_x - x
+    dy = waypoint_y - y
+    if literal_heading:
+        return u_glo, math.atan2(-dy, -dx)
+    return u_glo, math.atan2(dy, dx)
+
+
+@njit(cache=True)
 def combined_law(
     theta: float,
     e_omega: float,

@@ -52,6 +52,15 @@ class CoverageMap:
         self.coverage = np.zeros((rows, cols), dtype=np.int64)
         self.uncovered_cells = rows * cols
         self.deficit_ticks = rows * cols * self.target_ticks
+        self.counted_cells = rows * cols  # the cells e_D averages over
+
+    def start_from(self, head_start: np.ndarray) -> None:
+        """A terrain's start (:meth:`model.world.World.head_start`): cells at Λ* are out of e_D and of
+        completion; a priority map's cells start part-way. Only for a fresh map."""
+        self.coverage[...] = head_start
+        self.uncovered_cells = int((head_start < self.target_ticks).sum())
+        self.deficit_ticks = int(np.maximum(self.target_ticks - head_start, 0).sum())
+        self.counted_cells = int((head_start < self.target_ticks).sum())
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -69,8 +78,8 @@ class CoverageMap:
         return deficit.astype(np.float64) / self.target_ticks
 
     def domain_error(self) -> float:
-        """e_D, eq. 5: mean Υ over the domain (all cells have the same area)."""
-        return self.deficit_ticks / (self.target_ticks * self.coverage.size)
+        """e_D, eq. 5: mean Υ over the domain (all cells have the same area), coverable cells only."""
+        return self.deficit_ticks / (self.target_ticks * self.counted_cells)
 
     @property
     def complete(self) -> bool:

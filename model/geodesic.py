@@ -134,3 +134,27 @@ def descent_waypoint(
     start_col = min(max(math.floor(x / cell), 0), cols - 1)
     distance = field[start_row, start_col] + math.hypot((start_col + 0.5) * cell - x, (start_row + 0.5) * cell - y)
     return distance, waypoint_x, waypoint_y
+
+
+@njit(cache=True)
+def path_length(
+    field: np.ndarray,
+    occupied: np.ndarray,
+    x: float,
+    y: float,
+    goal_x: float,
+    goal_y: float,
+    cell: float,
+    radius: float,
+    bounded: bool,
+    straight: float,
+) -> float:
+    """Length of the shortest free path from (x, y) to the goal: ``straight`` (its straight distance)
+    when a straight drive gets there, else the goal's field at the robot's cell plus the way to that
+    cell's centre (as :func:`descent_waypoint` measures it); +inf when the goal cannot be reached."""
+    if in_sight(occupied, x, y, goal_x, goal_y, cell, radius, bounded):
+        return straight
+    rows, cols = field.shape
+    row = min(max(math.floor(y / cell), 0), rows - 1)
+    col = min(max(math.floor(x / cell), 0), cols - 1)
+    return field[row, col] + math.hypot((col + 0.5) * cell - x, (row + 0.5) * cell - y)

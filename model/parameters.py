@@ -13,6 +13,7 @@ from model.clearance import disk_is_free
 from model.coverage_map import CoverageMap
 from model.scenario import Scenario
 from model.step import LawParameters
+from model.world import world_of
 
 
 def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParameters:
@@ -30,6 +31,17 @@ def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParamete
         literal_heading=scenario.controller == "paper-literal",
         literal_omega=scenario.controller in ("paper-literal", "paper-eq16"),
     )
+
+
+def coverage_map_of(scenario: Scenario) -> CoverageMap:
+    """A fresh map of the scenario's grid, started as its world says (:meth:`model.world.World.head_start`:
+    cells nobody can cover are out of e_D; a priority map's cells start part-way)."""
+    rows, cols = scenario.grid_shape
+    coverage_map = CoverageMap(rows, cols, scenario.cell, scenario.lambda_star)
+    world = world_of(scenario)
+    if not world.open or scenario.priority_map:
+        coverage_map.start_from(world.head_start(coverage_map.target_ticks))
+    return coverage_map
 
 
 def initial_poses(scenario: Scenario) -> np.ndarray:
@@ -55,27 +67,61 @@ def free_initial_poses(
     clearance: float,
     reachable: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Poses (N, 3) drawn from ``seed`` uniformly over the grid, keeping those whose disk is free of
-    obstacles and of the map's edge by ``clearance``, at least 2·radius + clearance from the robots drawn
-    before, and (given ``reachable``) in a reachable cell: the terrain's counterpart of
-    :func:`initial_poses`. Raises ValueError when the free space cannot hold the team."""
+    """Poses (N, 3) drawn from ``seed`` as :func:`initial_poses` draws them (all x, all y, all θ, over
+    the grid's extent), keeping each robot whose disk is on the grid, ``clearance`` away from occupied
+    cells, at least 2·radius + clearance from the robots kept before it, and (given ``reachable``) in a
+    reachable cell; the others are drawn again, in rounds, in id order. On a grid with no occupied cell
+    and point robots every pose is kept at once: the poses are exactly :func:`initial_poses`'s. Raises
+    ValueError when the free space cannot hold the team."""
     rng = np.random.default_rng(seed)
     rows, cols = occupied.shape
-    poses: list[tuple[float, float, float]] = []
-    for agent in range(agents):
-        for _ in range(POSE_ATTEMPTS):
-            x, y = rng.uniform(0.0, cols * cell), rng.uniform(0.0, rows * cell)
-            theta = rng.uniform(-math.pi, math.pi)
-            if not disk_is_free(occupied, x, y, radius + clearance, cell, True):
-                continue
-            if reachable is not None and not reachable[min(int(y / cell), rows - 1), min(int(x / cell), cols - 1)]:
-                continue
-            if all(math.hypot(x - px, y - py) >= 2.0 * radius + clearance for px, py, _ in poses):
-                poses.append((x, y, theta))
-                break
-        else:
-            raise ValueError(
-                f"no free place for robot {agent} of {agents} after {POSE_ATTEMPTS} draws: the free space "
-                f"cannot hold {agents} robots of radius {radius} with clearance {clearance}"
-            )
-    return np.array(poses, dtype=np.float64)
+    poses = np.zeros((agents, 3))
+    placed: list[int] = []
+    pending = list(range(agents))
+    for _ in range(POSE_ATTEMPTS):
+        if not pending:
+            return poses
+        xs = rng.uniform(0.0, cols * cell, len(pending))
+        ys = rng.uniform(0.0, rows * cell, len(pending))
+        thetas = rng.uniform(-math.pi, math.pi, len(pending))
+        still: list[int] = []
+        for agent, x, y, theta in zip(pending, xs, ys, thetas, strict=True):
+            if _start_is_free(occupied, cell, x, y, radius, clearance, reachable) and all(
+                math.hypot(x - poses[other, 0], y - poses[other, 1]) >= 2.0 * radius + clearance for other in placed
+            ):
+                poses[agent] = (x, y, theta)
+                placed.append(agent)
+            else:
+                still.append(agent)
+        pending = still
+    raise ValueError(
+        f"no free place for robot {pending[0]} of {agents} after {POSE_ATTEMPTS} draws: the free space "
+        f"cannot hold {agents} robots of radius {radius} with clearance {clearance}"
+    )
+
+
+def _start_is_free(
+    occupied: np.ndarray, cell: float, x: float, y: float, radius: float, clearance: float, reachable: np.ndarray | None
+) -> bool:
+    rows, cols = occupied.shape
+    if not disk_is_free(occupied, x, y, radius, cell, True):
+        return False
+    if clearance > 0.0 and not disk_is_free(occupied, x, y, radius + clearance, cell, False):
+        return False
+    return reachable is None or bool(reachable[min(int(y / cell), rows - 1), min(int(x / cell), cols - 1)])
+
+
+START_CLEARANCE = 0.5
+"""Free distance, in cells, between a robot's disk and the nearest wall (or teammate) at the start."""
+
+
+def starting_poses(scenario: Scenario) -> np.ndarray:
+    """The team's poses at t_0: :func:`initial_poses` in the open world; on a terrain drawn in the team's
+    space, clear of walls and of each other (:func:`free_initial_poses`). ValueError: no room."""
+    world = world_of(scenario)
+    if world.open:
+        return initial_poses(scenario)
+    clearance = START_CLEARANCE * scenario.cell
+    return free_initial_poses(
+        world.occupied, scenario.cell, scenario.agents, scenario.seed, scenario.robot_radius, clearance, world.reachable
+    )

@@ -10,8 +10,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from model.assignment import assign_objectives
+from model.geodesic import path_length
 from model.objectives import BlobObjectives, fallback_objective, select_objectives
+from model.reachability import nearest_reachable
 from model.scenario import Scenario
+from model.world import World, world_of
 
 Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
 """(step, members, targets (N, 2), blob objectives Ψ (M, 2), blob labels of the grid or None)."""
@@ -25,7 +28,11 @@ class Planner:
     blobs: BlobObjectives = field(default_factory=BlobObjectives)
 
     def plan(self, lack: np.ndarray, positions: np.ndarray) -> np.ndarray:
-        """Objective (x, y) for every agent, shape (N, 2)."""
+        """Objective (x, y) for every agent, shape (N, 2).
+
+        On a terrain Algorithm 1 runs on the same Υ (cells nobody can cover are at Λ* already), each
+        objective is then moved into the team's space (:func:`model.reachability.nearest_reachable`)
+        and Algorithm 2 takes the lengths of the shortest free paths to them (:func:`path_lengths`)."""
         self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range)
         objectives = self.blobs.positions
         if len(objectives) == 0:
@@ -33,7 +40,11 @@ class Planner:
             if fallback is None:
                 return positions.copy()
             objectives = fallback[None, :]
-        return objectives[assign_objectives(positions, objectives)]
+        world = world_of(self.scenario)
+        if not world.ground.walls:
+            return objectives[assign_objectives(positions, objectives)]
+        objectives = nearest_reachable(world.reachable, objectives, self.scenario.cell)
+        return objectives[assign_objectives(positions, objectives, path_lengths(world, positions, objectives))]
 
     def labels(self) -> np.ndarray | None:
         """The blob labels of the last plan, as the recording keeps them (uint16), or None."""
@@ -42,3 +53,18 @@ class Planner:
     def record(self, step: int, targets: np.ndarray) -> Plan:
         """This plan as kept for the recording: members are all agents, in id order."""
         return (step, tuple(range(len(targets))), targets.copy(), self.blobs.positions.copy(), self.labels())
+
+
+def path_lengths(world: World, positions: np.ndarray, objectives: np.ndarray) -> np.ndarray:
+    """(N, M) lengths of the shortest free paths from each robot to each objective: the straight
+    distance when a straight drive gets there (as eq. 17 has it in the open), else the geodesic one."""
+    ground = world.ground
+    cell = world.scenario.cell
+    lengths = np.linalg.norm(positions[:, None, :] - objectives[None, :, :], axis=2)
+    for j, (goal_x, goal_y) in enumerate(objectives):
+        field = world.field(goal_x, goal_y)
+        for i, (x, y) in enumerate(positions):
+            lengths[i, j] = path_length(
+                field, ground.occupied, x, y, goal_x, goal_y, cell, ground.plan_radius, ground.bounded, lengths[i, j]
+            )
+    return lengths

@@ -31,23 +31,30 @@ def reachable_cells(passable: np.ndarray, starts: list[tuple[int, int]], cell: f
 
 @njit(cache=True)
 def _seen_from(occupied: np.ndarray, reachable: np.ndarray, sensing_range: float, cell: float) -> np.ndarray:
+    """Free cells within R of a reachable cell's centre in clear sight. A reachable cell sees itself;
+    any other free cell looks for one reachable centre, stopping at the first (most cells are near one)."""
     rows, cols = occupied.shape
-    seen = np.zeros((rows, cols), dtype=np.bool_)
+    seen = reachable.copy()
     span = math.ceil(sensing_range / cell)
     for row in range(rows):
         for col in range(cols):
-            if not reachable[row, col]:
+            if seen[row, col] or occupied[row, col]:
                 continue
-            x, y = (col + 0.5) * cell, (row + 0.5) * cell
+            tx, ty = (col + 0.5) * cell, (row + 0.5) * cell
+            found = False
             for r in range(max(row - span, 0), min(row + span + 1, rows)):
                 for c in range(max(col - span, 0), min(col + span + 1, cols)):
-                    if seen[r, c] or occupied[r, c]:
+                    if not reachable[r, c]:
                         continue
-                    tx, ty = (c + 0.5) * cell, (r + 0.5) * cell
+                    x, y = (c + 0.5) * cell, (r + 0.5) * cell
                     if math.hypot(tx - x, ty - y) >= sensing_range:
                         continue
                     if not segment_crosses_occupied(occupied, x, y, tx, ty, cell):
-                        seen[r, c] = True
+                        found = True
+                        break
+                if found:
+                    break
+            seen[row, col] = found
     return seen
 
 

@@ -12,6 +12,9 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from model.scenario_terrain import resolve_terrain_keys
+from model.terrain import TerrainError
+
 CONTROLLERS = ("paper", "paper-literal", "paper-eq16", "zigzag")
 """``paper``: the chosen readings of eq. 11 and 16; ``paper-literal``: both as printed; ``paper-eq16``: eq. 11
 read toward the objective but eq. 16 as printed; ``zigzag``: Fig. 8 (docs/paper-notes.md)."""
@@ -44,6 +47,13 @@ class Scenario:
     max_time: float = 10000.0
     controller: str = "paper"
     replan_period: float = 5.0
+    # Terrain (issue 11); the defaults are the paper's open world and leave every run as it was.
+    map: str = ""  # a ROS map YAML, absolute (the file names it relative to itself); "" = none
+    obstacles: tuple[tuple[tuple[float, float], ...], ...] = ()  # polygons [[x, y], ...]
+    robot_radius: float = 0.0  # r: a robot is a disk (0: the paper's point robot)
+    occlusion: bool = True  # walls and teammates' disks hide what lies behind them
+    priority_map: str = ""  # an image whose grey level gives Λ*(x) from lambda_star_min to lambda_star
+    lambda_star_min: float = 0.0
 
     @property
     def half_angle(self) -> float:
@@ -64,15 +74,33 @@ class Scenario:
         return max(1, round(self.replan_period / self.dt))
 
     def to_dict(self) -> dict[str, Any]:
+        """The scenario as a file would state it; terrain keys only when they differ from the open
+        world, so the paper's summary.json is what it always was."""
         values = asdict(self)
         values["domain"] = list(self.domain)
+        values["obstacles"] = [[list(point) for point in polygon] for polygon in self.obstacles]
+        for key in TERRAIN_KEYS:
+            if getattr(self, key) == getattr(_OPEN_WORLD, key) or (key == "occlusion" and not self.has_terrain):
+                del values[key]
+        if self.priority_map:
+            values["lambda_star"] = values.pop("priority_map")
+            values["lambda_star_max"] = self.lambda_star
+            values["lambda_star_min"] = self.lambda_star_min
         return values
+
+    @property
+    def has_terrain(self) -> bool:
+        """Walls, a map's edge or robots with a body: anything the paper's open world does not have."""
+        return bool(self.map or self.obstacles or self.robot_radius > 0.0)
 
     def with_overrides(self, **overrides: Any) -> Scenario:
         """A validated copy with some keys replaced (``None`` values are ignored)."""
         given = {key: value for key, value in overrides.items() if value is not None}
         return validate(self.to_dict() | given)
 
+
+TERRAIN_KEYS = ("map", "obstacles", "robot_radius", "occlusion", "priority_map", "lambda_star_min")
+_OPEN_WORLD = Scenario()
 
 _POSITIVE_FLOATS = (
     "cell",
@@ -94,15 +122,22 @@ def _number(key: str, value: Any) -> float:
     return float(value)
 
 
-def validate(values: dict[str, Any]) -> Scenario:
-    """Build a Scenario from a mapping, checking every key; raise ScenarioError naming the bad one."""
-    known = {name for name in Scenario.__dataclass_fields__}
+def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
+    """Build a Scenario from a mapping, checking every key; raise ScenarioError naming the bad one.
+    Files the scenario names (``map``, a priority map) are relative to ``base`` (the scenario's folder)."""
+    known = {name for name in Scenario.__dataclass_fields__ if name != "priority_map"} | {"lambda_star_max"}
     unknown = sorted(set(values) - known)
     if unknown:
         raise ScenarioError(f"unknown scenario key '{unknown[0]}': expected one of {', '.join(sorted(known))}")
+    try:
+        values = resolve_terrain_keys(dict(values), base or Path.cwd())
+    except TerrainError as error:
+        raise ScenarioError(str(error)) from error
     resolved: dict[str, Any] = {}
     for key, value in values.items():
-        if key == "domain":
+        if key in TERRAIN_KEYS:
+            resolved[key] = value
+        elif key == "domain":
             if not isinstance(value, list | tuple) or len(value) != 2:
                 raise ScenarioError(f"scenario key 'domain': expected [width, height], got {value!r}")
             width, height = (_number("domain", item) for item in value)
@@ -134,6 +169,11 @@ def validate(values: dict[str, Any]) -> Scenario:
                 raise ScenarioError(f"scenario key '{key}': expected a positive number, got {value!r}")
             resolved[key] = number
     scenario = replace(Scenario(), **resolved)
+    if scenario.controller == "zigzag" and scenario.has_terrain:
+        raise ScenarioError(
+            "scenario key 'controller': 'zigzag' flies the open domain's lanes and knows no walls or robot "
+            "bodies; with map, obstacles or robot_radius use one of paper, paper-literal, paper-eq16"
+        )
     rows, cols = scenario.grid_shape
     for axis, cells, size in (("width", cols, scenario.domain[0]), ("height", rows, scenario.domain[1])):
         if cells < 1 or abs(cells * scenario.cell - size) > 1e-9 * size:
@@ -155,6 +195,6 @@ def load_scenario(path: str | Path) -> Scenario:
     except tomllib.TOMLDecodeError as error:
         raise ScenarioError(f"scenario file {path} is not valid TOML: {error}") from error
     try:
-        return validate(values)
+        return validate(values, path.parent)
     except ScenarioError as error:
         raise ScenarioError(f"{path}: {error}") from error

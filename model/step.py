@@ -11,8 +11,11 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from model.control import combined_law, global_law, local_law
+from model.clearance import disk_is_free, step_or_stay
+from model.control import combined_law, global_law, global_law_around_walls, local_law
 from model.dynamics import unicycle_step
+from model.geodesic import descent_waypoint
+from model.ground import Ground
 from model.sensing import sense_wedge
 
 
@@ -34,40 +37,142 @@ class LawParameters(NamedTuple):
 
 @njit(cache=True)
 def decide_and_sense(
-    coverage: np.ndarray, x: float, y: float, theta: float, objective_x: float, objective_y: float, law: LawParameters
+    coverage: np.ndarray,
+    x: float,
+    y: float,
+    theta: float,
+    objective_x: float,
+    objective_y: float,
+    law: LawParameters,
+    ground: Ground,
+    field: np.ndarray,
+    positions: np.ndarray,
+    me: int,
 ) -> tuple[float, float, float, int, int, np.ndarray]:
-    """(v, ω, e_Ω) of one agent from its map and objective (eq. 6–16), and its delta window (eq. 3)."""
+    """(v, ω, e_Ω) of one agent from its map and objective (eq. 6–16), and its delta window (eq. 3).
+
+    On a terrain: ``field`` is the geodesic distance field of the objective (the global law follows the
+    shortest free path when a wall hides it), ``positions`` (N, 2) every robot's position with this
+    one's at row ``me`` (teammates hide cells); in the open world neither is read."""
     e_omega, w_left, w_right, row0, col0, ticks = sense_wedge(
-        coverage, law.target_ticks, x, y, theta, law.sensing_range, law.half_angle, law.alpha_max, law.dt, law.cell
+        coverage,
+        law.target_ticks,
+        x,
+        y,
+        theta,
+        law.sensing_range,
+        law.half_angle,
+        law.alpha_max,
+        law.dt,
+        law.cell,
+        ground,
+        positions,
+        me,
     )
     u_loc, theta_loc = local_law(e_omega, w_left, w_right, theta, law.half_angle)
     u_glo, theta_glo = global_law(x, y, objective_x, objective_y, law.sensing_range, law.literal_heading)
+    if ground.walls:
+        u_glo, theta_glo = _global_law_on_terrain(x, y, objective_x, objective_y, u_glo, theta_glo, law, ground, field)
     v, omega = combined_law(
         theta, e_omega, u_loc, theta_loc, u_glo, theta_glo, law.beta, law.k_v, law.k_omega, law.literal_omega
     )
+    if (ground.walls or ground.bounded) and not _step_is_free(x, y, theta, v, omega, law, ground):
+        # The weighted laws push into a wall (they can balance there: e_θ = 0 with v > 0, for ever).
+        # Take the global law alone, W_glo = 1 (eq. 12-16 with e_Ω = 0): it follows the free path.
+        v, omega = combined_law(
+            theta, 0.0, u_loc, theta_loc, u_glo, theta_glo, law.beta, law.k_v, law.k_omega, law.literal_omega
+        )
     return v, omega, e_omega, row0, col0, ticks
 
 
-def load_kernels(coverage: np.ndarray, pose: tuple[float, float, float], law: LawParameters) -> None:
+@njit(cache=True)
+def _global_law_on_terrain(
+    x: float,
+    y: float,
+    objective_x: float,
+    objective_y: float,
+    u_glo: float,
+    theta_glo: float,
+    law: LawParameters,
+    ground: Ground,
+    field: np.ndarray,
+) -> tuple[float, float]:
+    """Eq. 10–11 among walls: as printed (``u_glo``, ``theta_glo``) while a straight drive reaches the
+    objective, else along the shortest free path; never backing away (u_glo ≥ 0)."""
+    distance, waypoint_x, waypoint_y = descent_waypoint(
+        field,
+        ground.passable,
+        ground.occupied,
+        x,
+        y,
+        objective_x,
+        objective_y,
+        law.cell,
+        ground.lookahead,
+        ground.plan_radius,
+        ground.bounded,
+    )
+    if waypoint_x != objective_x or waypoint_y != objective_y:
+        u_glo, theta_glo = global_law_around_walls(x, y, waypoint_x, waypoint_y, distance, law.literal_heading)
+    # Eq. 10's u_glo < 0 inside R/2 backs the robot away blind; among walls that backs it into them,
+    # or out of sight of the objective and in again, for ever. Here it stops and turns to face it.
+    return max(u_glo, 0.0), theta_glo
+
+
+@njit(cache=True)
+def _step_is_free(x: float, y: float, theta: float, v: float, omega: float, law: LawParameters, ground: Ground) -> bool:
+    next_x, next_y, _ = unicycle_step(x, y, theta, v, omega, law.dt)
+    return disk_is_free(ground.occupied, next_x, next_y, ground.radius, law.cell, ground.bounded)
+
+
+def load_kernels(coverage: np.ndarray, pose: tuple[float, float, float], law: LawParameters, ground: Ground) -> None:
     """Have numba load the control kernels now, with the argument types of the real calls (half a second
     from its cache at the first call), on a scratch map: nothing of the agent's state changes."""
     x, y, theta = pose
-    v, omega, _, _, _, _ = decide_and_sense(np.zeros_like(coverage), x, y, theta, x + 1.0, y, law)
-    move(x, y, theta, v, omega, law)
+    positions = np.array([[x, y]])
+    field = np.zeros(ground.occupied.shape)
+    v, omega, _, _, _, _ = decide_and_sense(
+        np.zeros_like(coverage), x, y, theta, x + 1.0, y, law, ground, field, positions, 0
+    )
+    move(x, y, theta, v, omega, law, ground)
 
 
 @njit(cache=True)
 def sense_only(
-    coverage: np.ndarray, x: float, y: float, theta: float, law: LawParameters
+    coverage: np.ndarray,
+    x: float,
+    y: float,
+    theta: float,
+    law: LawParameters,
+    ground: Ground,
+    positions: np.ndarray,
+    me: int,
 ) -> tuple[int, int, np.ndarray]:
     """The delta window of an agent whose velocities come from elsewhere (the zig-zag pilot)."""
     _, _, _, row0, col0, ticks = sense_wedge(
-        coverage, law.target_ticks, x, y, theta, law.sensing_range, law.half_angle, law.alpha_max, law.dt, law.cell
+        coverage,
+        law.target_ticks,
+        x,
+        y,
+        theta,
+        law.sensing_range,
+        law.half_angle,
+        law.alpha_max,
+        law.dt,
+        law.cell,
+        ground,
+        positions,
+        me,
     )
     return row0, col0, ticks
 
 
 @njit(cache=True)
-def move(x: float, y: float, theta: float, v: float, omega: float, law: LawParameters) -> tuple[float, float, float]:
-    """The pose after one step, eq. 1."""
+def move(
+    x: float, y: float, theta: float, v: float, omega: float, law: LawParameters, ground: Ground
+) -> tuple[float, float, float]:
+    """The pose after one step, eq. 1; on a terrain a step that would put the disk over a wall (or off
+    the map) is not taken as a move, only as a turn (:func:`model.clearance.step_or_stay`)."""
+    if ground.walls or ground.bounded:
+        return step_or_stay(ground.occupied, x, y, theta, v, omega, law.dt, ground.radius, law.cell, ground.bounded)
     return unicycle_step(x, y, theta, v, omega, law.dt)

@@ -27,6 +27,7 @@ from protocol.messages import (
     Pose,
     ProtocolError,
     RunControl,
+    ScenarioDigest,
     Snapshot,
     StepGo,
 )
@@ -241,6 +242,14 @@ def _decode_snapshot(body: dict[str, Any], limits: Limits) -> Snapshot:
     return Snapshot(coverage, applied, _poses(body, limits.agents - 1))
 
 
+def _decode_digest(body: dict[str, Any], limits: Limits) -> ScenarioDigest:
+    scenario, map_sha = body.get("scenario"), body.get("map")
+    for name, value, lengths in (("scenario", scenario, (64,)), ("map", map_sha, (0, 64))):
+        if not isinstance(value, str) or len(value) not in lengths or any(c not in "0123456789abcdef" for c in value):
+            raise ProtocolError("bad-field", f"{name} must be a sha256 in hex")
+    return ScenarioDigest(scenario, map_sha)
+
+
 _DECODERS: dict[str, Callable[[dict[str, Any], Limits], Message]] = {
     "delta": _decode_delta,
     "state": _decode_state,
@@ -249,6 +258,7 @@ _DECODERS: dict[str, Callable[[dict[str, Any], Limits], Message]] = {
     "go": _decode_go,
     "control": _decode_control,
     "snapshot": _decode_snapshot,
+    "scenario": _decode_digest,
 }
 """Each message type's decoder: it validates the body and builds the message, or raises ProtocolError."""
 

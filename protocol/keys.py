@@ -12,6 +12,7 @@ coordinator/go              StepGo               coordinator → all   lockstep:
 coordinator/objectives      Objectives           coordinator → all   realtime: the latest targets
 coordinator/snapshot        (queryable)          coordinator         map, sequences, poses: late joiners
 coordinator/history         (queryable)          coordinator         recent gos and the end of the run
+coordinator/scenario        (queryable)          coordinator         ScenarioDigest: what it runs (map sha256)
 coordinator/relay           (queryable)          coordinator         realtime: as agent/<id>/relay
 run/control                 RunControl           coordinator → all   run done / aborted
 run/status                  RunControl           coordinator → all   progress (e_D, step)
@@ -68,6 +69,10 @@ class TeamKeys:
     @property
     def all_histories(self) -> str:
         return f"{self.prefix}/agent/*/history"
+
+    @property
+    def scenario(self) -> str:
+        return f"{self.prefix}/coordinator/scenario"
 
     @property
     def go_history(self) -> str:

@@ -13,6 +13,7 @@ decode may touch a map or a controller.
     Objectives  step k, members, targets (one per member), blob objectives  Alg. 1–2
     RunControl  kind (done | abort | status), step, completed, e_D, reason
     Snapshot    the coverage map and the applied sequences per agent
+    ScenarioDigest  sha256 of the scenario as run and of its map (a process checks it joins its team's run)
 """
 
 from __future__ import annotations
@@ -134,7 +135,15 @@ class StepGo:
     states: tuple[AgentState, ...] = ()
 
 
-Message = MapDelta | AgentState | AgentStep | Objectives | RunControl | Snapshot | StepGo
+@dataclass(frozen=True)
+class ScenarioDigest:
+    """What the coordinator runs: sha256 (hex) of the scenario's keys, and of its map files ('' if none)."""
+
+    scenario: str
+    map_sha256: str
+
+
+Message = MapDelta | AgentState | AgentStep | Objectives | RunControl | Snapshot | StepGo | ScenarioDigest
 
 
 # ---------------------------------------------------------------- encoding
@@ -224,4 +233,6 @@ def encode(message: Message) -> bytes:
                 "poses": [[agent, *pose] for agent, pose in sorted(message.poses.items())],
             },
         )
+    if isinstance(message, ScenarioDigest):
+        return _pack("scenario", {"scenario": message.scenario, "map": message.map_sha256})
     raise TypeError(f"not a protocol message: {type(message).__name__}")

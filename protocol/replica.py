@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from model.coverage_map import CoverageMap
+from model.parameters import coverage_map_of
 from model.scenario import Scenario
 from protocol.messages import MapDelta, Snapshot
 
@@ -52,8 +53,10 @@ class MapReplica:
 
     @classmethod
     def of(cls, scenario: Scenario) -> MapReplica:
-        """An empty replica of a scenario's map."""
-        return cls(*scenario.grid_shape, scenario.cell, scenario.lambda_star)
+        """A fresh replica of a scenario's map (on a terrain, started as its world says)."""
+        replica = cls(*scenario.grid_shape, scenario.cell, scenario.lambda_star)
+        replica.map = coverage_map_of(scenario)
+        return replica
 
     def has(self, agent: int, seq: int) -> bool:
         """Whether (agent, seq) is in the map; every agent trivially has 'step −1' (nothing)."""

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 
+from model.parameters import starting_poses
 from model.scenario import CONTROLLERS, PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
 
 CLOCKS = ("lockstep", "realtime")
@@ -60,4 +61,15 @@ def scenario_from_arguments(args: argparse.Namespace) -> Scenario:
     speed = getattr(args, "speed", None)
     if speed is not None and speed <= 0:
         raise ScenarioError(f"--speed: expected a positive number, got {speed}")
+    check_world(scenario)
     return scenario
+
+
+def check_world(scenario: Scenario) -> None:
+    """Build the scenario's world and the team's starting poses now, so that a map with no room for the
+    team fails here, with the file named, before any process starts."""
+    where = f"map {scenario.map}" if scenario.map else "scenario"
+    try:
+        starting_poses(scenario)
+    except ValueError as error:  # TerrainError, or no room for the team
+        raise ScenarioError(f"{where}: {error}") from error

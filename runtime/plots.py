@@ -11,6 +11,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from model.run import RunResult
+from model.scenario import Scenario
+from model.world import world_of
 
 
 def plot_domain_error(result: RunResult, path: Path) -> None:
@@ -49,7 +51,7 @@ def plot_velocities(result: RunResult, path: Path) -> None:
 
 
 def plot_coverage_maps(result: RunResult, path: Path) -> None:
-    """Fig. 6: lack of coverage Υ at four times, with the trajectories so far."""
+    """Fig. 6: lack of coverage Υ at four times, with the trajectories so far (and the walls, on a terrain)."""
     scenario = result.scenario
     width, height = scenario.domain
     last = len(result.snapshots) - 1
@@ -65,6 +67,7 @@ def plot_coverage_maps(result: RunResult, path: Path) -> None:
             vmin=0.0,
             vmax=1.0,
         )
+        draw_obstacles(ax, scenario)
         upto = min(round(time / scenario.dt) + 1, len(result.trace))
         for agent in range(scenario.agents):
             (line,) = ax.plot(result.trace[:upto, agent, 0], result.trace[:upto, agent, 1], linewidth=0.6)
@@ -85,6 +88,18 @@ def plot_coverage_maps(result: RunResult, path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def draw_obstacles(ax: plt.Axes, scenario: Scenario) -> None:
+    """Occupied cells in brown, and free cells nobody can see hatched (nothing, in the open world)."""
+    world = world_of(scenario)
+    if world.open:
+        return
+    width, height = scenario.domain
+    layers = np.zeros((*world.occupied.shape, 4))
+    layers[world.occupied] = (0.45, 0.27, 0.1, 1.0)
+    layers[~world.occupied & ~world.coverable] = (0.2, 0.4, 0.9, 0.55)
+    ax.imshow(layers, origin="lower", extent=(0, width, 0, height), interpolation="nearest")
 
 
 def write_run_plots(result: RunResult, out_dir: Path) -> list[Path]:

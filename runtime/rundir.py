@@ -10,8 +10,10 @@ import json
 from pathlib import Path
 from typing import Any
 
+from model.fixed_point import COVERAGE_SCALE
 from model.metrics import optimum_time, total_sensing_ability
 from model.run import RunResult
+from model.world import World, world_of
 
 TRAJECTORY_HEADER = "t,agent,x,y,theta,v,omega"
 
@@ -37,8 +39,9 @@ def write_trajectory(result: RunResult, path: Path) -> None:
 def summary_of(result: RunResult) -> dict[str, Any]:
     """The summary.json fields (see README)."""
     scenario = result.scenario
+    world = world_of(scenario)
     ability = total_sensing_ability(scenario.range, scenario.half_angle, scenario.alpha_max)
-    optimum = optimum_time(scenario.domain[0] * scenario.domain[1], scenario.lambda_star, ability, scenario.agents)
+    optimum = optimum_time(covered_area(world), scenario.lambda_star, ability, scenario.agents)
     paths = result.path_lengths
     completion = result.completion_time if result.completed else None
     summary: dict[str, Any] = {
@@ -54,7 +57,19 @@ def summary_of(result: RunResult) -> dict[str, Any]:
     }
     if result.plan_time is not None:
         summary["plan_time"] = result.plan_time
+    if not world.open or scenario.priority_map:
+        summary["terrain"] = world.summary()
     return summary
+
+
+def covered_area(world: World) -> float:
+    """The area eq. 19's t*_N needs covered to Λ*: the domain's in the open world; on a terrain the
+    coverable cells' only, each weighted by its Λ*(x)/Λ* under a priority map."""
+    scenario = world.scenario
+    if world.open and not scenario.priority_map:
+        return scenario.domain[0] * scenario.domain[1]
+    target = round(scenario.lambda_star * COVERAGE_SCALE)
+    return float(world.targets[world.coverable].sum()) / target * scenario.cell**2
 
 
 def write_summary(summary: dict[str, Any], path: Path) -> None:
@@ -78,6 +93,12 @@ def format_summary(summary: dict[str, Any], out_dir: Path | None = None) -> str:
         + ", ".join(f"{length:.0f}" for length in summary["path_length"][:8])
         + (" ..." if len(summary["path_length"]) > 8 else ""),
     ]
+    terrain = summary.get("terrain")
+    if terrain is not None:
+        lines.append(
+            f"  terrain         {terrain['occupied_cells']} occupied cells, {terrain['coverable_cells']} coverable, "
+            f"{terrain['unreachable_cells']} free but unreachable (left out of e_D)"
+        )
     if out_dir is not None:
         lines.append(f"  outputs         {out_dir}/")
     return "\n".join(lines)

@@ -8,11 +8,14 @@ import numpy as np
 
 from coordinator.node import Coordinator, CoordinatorOptions
 from model.coverage_map import CoverageMap
+from model.ground import NO_FIELD, NO_POSITIONS, open_ground
 from model.parameters import initial_poses, law_parameters
 from model.scenario import Scenario
 from model.step import decide_and_sense, move
 from protocol.inbox import Membership, Received
 from protocol.messages import AgentState, AgentStep, MapDelta
+
+OPEN = open_ground()
 
 SCENARIO = Scenario(domain=(30.0, 30.0), agents=2, range=8.0, seed=3)
 
@@ -31,8 +34,10 @@ def team_steps(scenario: Scenario, steps: int) -> list[list[AgentStep]]:
     for step in range(steps):
         of_step = []
         for agent, (x, y, theta) in enumerate(poses):
-            v, omega, e_omega, row0, col0, ticks = decide_and_sense(grid.coverage, x, y, theta, 15.0, 15.0, law)
-            next_pose = move(x, y, theta, v, omega, law)
+            v, omega, e_omega, row0, col0, ticks = decide_and_sense(
+                grid.coverage, x, y, theta, 15.0, 15.0, law, OPEN, NO_FIELD, NO_POSITIONS, 0
+            )
+            next_pose = move(x, y, theta, v, omega, law, OPEN)
             delta = MapDelta(agent, step, row0, col0, ticks)
             of_step.append(AgentStep(delta, AgentState(agent, step, (x, y, theta), v, omega, e_omega, next_pose)))
             poses[agent] = next_pose

@@ -1,6 +1,5 @@
 """protocol.messages: every message type goes on the wire and comes back whole."""
 
-
 import numpy as np
 
 from protocol.decoding import decode

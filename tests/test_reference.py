@@ -8,9 +8,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from model.fixed_point import COVERAGE_SCALE
+from model.ground import NO_POSITIONS, open_ground
 from model.reference import wedge_readings
 from model.sensing import sense_wedge
 from model.step import LawParameters
+
+OPEN = (open_ground(), NO_POSITIONS, 0)  # the paper's open world: nothing hides anything
 
 LAW = LawParameters(20.0, math.radians(27.0), 50.0, 1.0, 1.0, 1.0, 0.1, 1.0, 100 * COVERAGE_SCALE, False, False)
 CENTRES = np.meshgrid(np.arange(100) + 0.5, np.arange(100) + 0.5)
@@ -23,7 +26,7 @@ def test_kernel_matches_numpy_reference_inside_the_domain(x, y, theta, seed):
     coverage = (rng.random((100, 100)) < 0.5) * LAW.target_ticks + rng.integers(0, LAW.target_ticks // 2, (100, 100))
     lack = np.maximum(0.0, 1.0 - coverage / LAW.target_ticks)
     e_omega, w_left, w_right, row0, col0, ticks = sense_wedge(
-        coverage, LAW.target_ticks, x, y, theta, 20.0, LAW.half_angle, 50.0, 0.1, 1.0
+        coverage, LAW.target_ticks, x, y, theta, 20.0, LAW.half_angle, 50.0, 0.1, 1.0, *OPEN
     )
     ref_e, ref_left, ref_right, ref_delta = wedge_readings(lack, x, y, theta, LAW, CENTRES)
     assert w_left == pytest.approx(ref_left, rel=1e-9, abs=1e-9)

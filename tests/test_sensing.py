@@ -6,8 +6,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from model.fixed_point import COVERAGE_SCALE
+from model.ground import NO_POSITIONS, open_ground
 from model.metrics import total_sensing_ability
 from model.sensing import lack_of_coverage, sense_wedge, sensing_ability
+
+OPEN = (open_ground(), NO_POSITIONS, 0)  # the paper's open world: nothing hides anything
 
 R, F, ALPHA = 20.0, math.radians(27.0), 50.0
 TARGET = 100 * COVERAGE_SCALE
@@ -45,7 +48,7 @@ def test_delta_integrates_to_total_ability_times_dt(cell, theta):
     cells = int(100 / cell)
     coverage = np.zeros((cells, cells), dtype=np.int64)
     dt = 0.1
-    *_, ticks = sense_wedge(coverage, TARGET, 50.0, 50.0, theta, R, F, ALPHA, dt, cell)
+    *_, ticks = sense_wedge(coverage, TARGET, 50.0, 50.0, theta, R, F, ALPHA, dt, cell, *OPEN)
     integral = ticks.sum() / COVERAGE_SCALE * cell * cell
     exact = total_sensing_ability(R, F, ALPHA) * dt
     assert integral == pytest.approx(exact, rel=0.02 if cell == 1.0 else 0.006)
@@ -53,7 +56,7 @@ def test_delta_integrates_to_total_ability_times_dt(cell, theta):
 
 def test_fresh_map_reads_full_error_and_balanced_gradient_when_heading_along_axis():
     coverage = np.zeros((100, 100), dtype=np.int64)
-    e_omega, w_left, w_right, *_ = sense_wedge(coverage, TARGET, 50.5, 50.5, 0.0, R, F, ALPHA, 0.1, 1.0)
+    e_omega, w_left, w_right, *_ = sense_wedge(coverage, TARGET, 50.5, 50.5, 0.0, R, F, ALPHA, 0.1, 1.0, *OPEN)
     assert e_omega == 1.0
     assert w_left == pytest.approx(w_right)
     assert w_left > 0.0
@@ -62,7 +65,7 @@ def test_fresh_map_reads_full_error_and_balanced_gradient_when_heading_along_axi
 def test_covered_left_half_pulls_gradient_right():
     coverage = np.zeros((100, 100), dtype=np.int64)
     coverage[51:, :] = TARGET  # rows above the agent (left when heading +x) are covered
-    e_omega, w_left, w_right, *_ = sense_wedge(coverage, TARGET, 50.5, 50.5, 0.0, R, F, ALPHA, 0.1, 1.0)
+    e_omega, w_left, w_right, *_ = sense_wedge(coverage, TARGET, 50.5, 50.5, 0.0, R, F, ALPHA, 0.1, 1.0, *OPEN)
     assert w_left == 0.0 and w_right > 0.0
     assert 0.4 < e_omega < 0.6
 
@@ -70,7 +73,7 @@ def test_covered_left_half_pulls_gradient_right():
 def test_wedge_outside_domain_counts_area_but_no_error():
     coverage = np.zeros((100, 100), dtype=np.int64)
     e_omega, w_left, w_right, _row0, _col0, ticks = sense_wedge(
-        coverage, TARGET, 100.0, 50.5, 0.0, R, F, ALPHA, 0.1, 1.0
+        coverage, TARGET, 100.0, 50.5, 0.0, R, F, ALPHA, 0.1, 1.0, *OPEN
     )
     assert e_omega == 0.0 and w_left == 0.0 and w_right == 0.0
     assert ticks.size == 0 or ticks.sum() == 0
@@ -80,7 +83,9 @@ def test_wedge_outside_domain_counts_area_but_no_error():
 @given(st.floats(-30.0, 130.0), st.floats(-30.0, 130.0), st.floats(-math.pi, math.pi))
 def test_delta_window_lies_inside_grid_and_is_non_negative(x, y, theta):
     coverage = np.zeros((100, 100), dtype=np.int64)
-    e_omega, w_left, w_right, row0, col0, ticks = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0)
+    e_omega, w_left, w_right, row0, col0, ticks = sense_wedge(
+        coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, *OPEN
+    )
     assert 0.0 <= e_omega <= 1.0
     assert w_left >= 0.0 and w_right >= 0.0
     assert (ticks >= 0).all()
