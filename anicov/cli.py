@@ -76,6 +76,17 @@ def command_reproduce(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def command_terrain_study(args: argparse.Namespace) -> int:
+    from anicov.reproduce import parse_team_range
+    from anicov.terrain_study import run_study
+
+    if args.runs < 1:
+        raise ScenarioError(f"--runs: expected a positive number of runs, got {args.runs}")
+    run_study(args.runs, parse_team_range(args.teams), Path(args.out), args.workers)
+    print(f"terrain study written to {args.out}/terrain.md")
+    return EXIT_OK
+
+
 def command_router(args: argparse.Namespace) -> int:
     import zenoh
 
@@ -159,6 +170,13 @@ def _add_in_process_commands(commands: argparse._SubParsersAction) -> None:
     reproduce.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
     reproduce.add_argument("--seed", type=int, default=0, help="base seed; run r of every team uses seed+r")
     reproduce.set_defaults(handler=command_reproduce)
+
+    terrain = commands.add_parser("terrain-study", help="every shipped map against the empty domain (issue 11)")
+    terrain.add_argument("--out", required=True, help="output directory (docs/terrain holds the committed one)")
+    terrain.add_argument("--runs", type=int, default=100, help="seeded runs per case (default 100)")
+    terrain.add_argument("--teams", default="1,4,10", help="team sizes (default 1,4,10)")
+    terrain.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    terrain.set_defaults(handler=command_terrain_study)
 
 
 def _add_bus_tools(commands: argparse._SubParsersAction) -> None:

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.sparse import coo_matrix
+from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from model.clearance import disk_is_free, swept_disk_is_free
@@ -59,13 +59,16 @@ def grid_graph(passable: np.ndarray, cell: float) -> coo_matrix:
     return coo_matrix((np.concatenate(costs), (np.concatenate(sources), np.concatenate(targets))), shape=(size, size))
 
 
-def distance_fields(passable: np.ndarray, goals: list[tuple[int, int]], cell: float) -> np.ndarray:
+def distance_fields(
+    passable: np.ndarray, goals: list[tuple[int, int]], cell: float, graph: csr_matrix | None = None
+) -> np.ndarray:
     """Geodesic distance from every cell to each goal cell, shape (len(goals), rows, cols); +inf where
-    a cell cannot reach the goal (or is not passable)."""
+    a cell cannot reach the goal (or is not passable). ``graph``: :func:`grid_graph` in CSR form, if
+    the caller keeps it (it depends on the passable cells only)."""
     rows, cols = passable.shape
     if not goals:
         return np.zeros((0, rows, cols))
-    graph = grid_graph(passable, cell).tocsr()
+    graph = grid_graph(passable, cell).tocsr() if graph is None else graph
     indices = [row * cols + col for row, col in goals]
     # The graph is symmetric: distances from the goal are distances to it.
     fields = dijkstra(graph, directed=True, indices=indices)

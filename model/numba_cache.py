@@ -25,6 +25,8 @@ KERNEL_SOURCES = (
     "model/clearance.py",
     "model/geodesic.py",
     "model/reachability.py",
+    "model/wall_law.py",
+    "model/ground.py",
     "model/fixed_point.py",
     "model/coverage_map.py",
     "anicov/engine.py",

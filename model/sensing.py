@@ -169,7 +169,10 @@ def _what_may_hide(
     if ground.radius > 0.0:
         for k in range(positions.shape[0]):
             px, py = positions[k, 0], positions[k, 1]
-            if k == me or px != px or math.hypot(px - x, py - y) > sensing_range + ground.radius:
+            gap = math.hypot(px - x, py - y)
+            # Bodies that overlap (closer than 2r: robots that drove through each other, which only the
+            # safety filter prevents) hide nothing from each other: one would otherwise be blind.
+            if k == me or px != px or gap > sensing_range + ground.radius or gap < 2.0 * ground.radius:
                 continue
             near[count, 0], near[count, 1] = px, py
             count += 1

@@ -12,11 +12,11 @@ import numpy as np
 from numba import njit
 
 from model.clearance import disk_is_free, step_or_stay
-from model.control import combined_law, global_law, global_law_around_walls, local_law
+from model.control import combined_law, global_law, local_law
 from model.dynamics import unicycle_step
-from model.geodesic import descent_waypoint
 from model.ground import Ground
 from model.sensing import sense_wedge
+from model.wall_law import global_law_among_walls
 
 
 class LawParameters(NamedTuple):
@@ -33,6 +33,35 @@ class LawParameters(NamedTuple):
     target_ticks: int  # Λ* in fixed-point ticks
     literal_heading: bool  # eq. 11 as printed
     literal_omega: bool  # eq. 16 as printed
+
+
+@njit(cache=True)
+def read_wedge(
+    coverage: np.ndarray,
+    x: float,
+    y: float,
+    theta: float,
+    law: LawParameters,
+    ground: Ground,
+    positions: np.ndarray,
+    me: int,
+) -> tuple[float, float, float, int, int, np.ndarray]:
+    """:func:`model.sensing.sense_wedge` with the law's sensor."""
+    return sense_wedge(
+        coverage,
+        law.target_ticks,
+        x,
+        y,
+        theta,
+        law.sensing_range,
+        law.half_angle,
+        law.alpha_max,
+        law.dt,
+        law.cell,
+        ground,
+        positions,
+        me,
+    )
 
 
 @njit(cache=True)
@@ -54,25 +83,25 @@ def decide_and_sense(
     On a terrain: ``field`` is the geodesic distance field of the objective (the global law follows the
     shortest free path when a wall hides it), ``positions`` (N, 2) every robot's position with this
     one's at row ``me`` (teammates hide cells); in the open world neither is read."""
-    e_omega, w_left, w_right, row0, col0, ticks = sense_wedge(
-        coverage,
-        law.target_ticks,
-        x,
-        y,
-        theta,
-        law.sensing_range,
-        law.half_angle,
-        law.alpha_max,
-        law.dt,
-        law.cell,
-        ground,
-        positions,
-        me,
-    )
+    e_omega, w_left, w_right, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, positions, me)
     u_loc, theta_loc = local_law(e_omega, w_left, w_right, theta, law.half_angle)
     u_glo, theta_glo = global_law(x, y, objective_x, objective_y, law.sensing_range, law.literal_heading)
     if ground.walls:
-        u_glo, theta_glo = _global_law_on_terrain(x, y, objective_x, objective_y, u_glo, theta_glo, law, ground, field)
+        u_glo, theta_glo = global_law_among_walls(
+            coverage,
+            law.target_ticks,
+            x,
+            y,
+            objective_x,
+            objective_y,
+            u_glo,
+            theta_glo,
+            law.sensing_range,
+            law.cell,
+            law.literal_heading,
+            ground,
+            field,
+        )
     v, omega = combined_law(
         theta, e_omega, u_loc, theta_loc, u_glo, theta_glo, law.beta, law.k_v, law.k_omega, law.literal_omega
     )
@@ -83,40 +112,6 @@ def decide_and_sense(
             theta, 0.0, u_loc, theta_loc, u_glo, theta_glo, law.beta, law.k_v, law.k_omega, law.literal_omega
         )
     return v, omega, e_omega, row0, col0, ticks
-
-
-@njit(cache=True)
-def _global_law_on_terrain(
-    x: float,
-    y: float,
-    objective_x: float,
-    objective_y: float,
-    u_glo: float,
-    theta_glo: float,
-    law: LawParameters,
-    ground: Ground,
-    field: np.ndarray,
-) -> tuple[float, float]:
-    """Eq. 10–11 among walls: as printed (``u_glo``, ``theta_glo``) while a straight drive reaches the
-    objective, else along the shortest free path; never backing away (u_glo ≥ 0)."""
-    distance, waypoint_x, waypoint_y = descent_waypoint(
-        field,
-        ground.passable,
-        ground.occupied,
-        x,
-        y,
-        objective_x,
-        objective_y,
-        law.cell,
-        ground.lookahead,
-        ground.plan_radius,
-        ground.bounded,
-    )
-    if waypoint_x != objective_x or waypoint_y != objective_y:
-        u_glo, theta_glo = global_law_around_walls(x, y, waypoint_x, waypoint_y, distance, law.literal_heading)
-    # Eq. 10's u_glo < 0 inside R/2 backs the robot away blind; among walls that backs it into them,
-    # or out of sight of the objective and in again, for ever. Here it stops and turns to face it.
-    return max(u_glo, 0.0), theta_glo
 
 
 @njit(cache=True)
@@ -149,21 +144,7 @@ def sense_only(
     me: int,
 ) -> tuple[int, int, np.ndarray]:
     """The delta window of an agent whose velocities come from elsewhere (the zig-zag pilot)."""
-    _, _, _, row0, col0, ticks = sense_wedge(
-        coverage,
-        law.target_ticks,
-        x,
-        y,
-        theta,
-        law.sensing_range,
-        law.half_angle,
-        law.alpha_max,
-        law.dt,
-        law.cell,
-        ground,
-        positions,
-        me,
-    )
+    _, _, _, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, positions, me)
     return row0, col0, ticks
 
 

@@ -9,7 +9,9 @@ wedge of eq. 2 *and* the open segment p → c crosses no occupied cell and no ot
   too, so a wall drawn as a diagonal staircase of cells does not leak. The robot's own cell and the target cell are not tested: the robot never
   stands in an occupied cell, and an occupied target has nothing to cover.
 - Teammates: a disk of radius r around each other robot's position hides c when the segment p → c
-  comes closer than r to its centre (a robot does not hide itself; point robots, r = 0, hide nothing).
+  comes closer than r to its centre (a robot does not hide itself; point robots, r = 0, hide nothing;
+  a teammate whose disk overlaps this robot's, closer than 2r, hides nothing either: without a safety
+  filter robots drive through each other, and a robot inside another would see nothing at all).
 
 Pure numba kernels: the engine and the agent processes call the same code.
 """

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from model.fixed_point import COVERAGE_SCALE
@@ -93,8 +94,12 @@ class World:
 
     @functools.lru_cache(maxsize=256)  # noqa: B019 - one World per scenario, kept for the process's life
     def _field(self, row: int, col: int) -> np.ndarray:
-        field = distance_fields(self.passable, [(row, col)], self.scenario.cell)[0]
+        field = distance_fields(self.passable, [(row, col)], self.scenario.cell, self._graph)[0]
         return field
+
+    @functools.cached_property
+    def _graph(self) -> csr_matrix:
+        return grid_graph(self.passable, self.scenario.cell).tocsr()
 
     def summary(self) -> dict[str, object]:
         """What summary.json reports of the terrain."""

@@ -2,9 +2,13 @@ import numpy as np
 import pytest
 
 from anicov.engine import run_scenario
+from model.clearance import disk_is_free
 from model.metrics import optimum_time, total_sensing_ability
 from model.parameters import initial_poses
 from model.run import TRACE_FIELDS
+from model.scenario import validate
+from model.world import world_of
+from runtime.rundir import format_summary, summary_of
 
 
 def test_initial_poses_are_seeded_and_inside_the_domain(paper_scenario):
@@ -72,3 +76,61 @@ def test_halving_cell_and_dt_moves_mean_completion_time_under_5_percent(paper_sc
     fine_scenario = paper_scenario.with_overrides(cell=0.5, dt=0.05)
     fine = [run_scenario(fine_scenario.with_overrides(seed=s), record_trace=False).completion_time for s in seeds]
     assert abs(np.mean(fine) - np.mean(coarse)) / np.mean(coarse) < 0.05
+
+
+# ---------------------------------------------------------------- terrain (issue 11)
+
+CORRIDOR = [[[0.0, 0.0], [40.0, 0.0], [40.0, 4.0], [0.0, 4.0]], [[0.0, 8.0], [40.0, 8.0], [40.0, 12.0], [0.0, 12.0]]]
+
+
+def test_an_empty_map_gives_the_papers_run_byte_for_byte(tmp_path, paper_scenario):
+    from tests.conftest import write_map
+
+    open_run = run_scenario(paper_scenario)
+    # The equality below says something only if the paper's robots never try to leave the domain,
+    # which a map forbids: they do not in this run.
+    assert open_run.trace[:, :, :2].min() > 0.0 and open_run.trace[:, :, :2].max() < 100.0
+    write_map(tmp_path, "empty", np.zeros((100, 100), dtype=bool))
+    on_map = run_scenario(validate({**paper_scenario.to_dict(), "map": "empty.yaml", "domain": [100, 100]}, tmp_path))
+    assert np.array_equal(on_map.trace, open_run.trace) and np.array_equal(on_map.errors, open_run.errors)
+    assert on_map.completion_time == open_run.completion_time
+
+
+def test_a_robot_in_a_corridor_never_touches_its_walls():
+    scenario = validate(
+        {"domain": [40.0, 12.0], "obstacles": CORRIDOR, "robot_radius": 0.5, "agents": 2, "max_time": 400.0}
+    )
+    world = world_of(scenario)
+    result = run_scenario(scenario)
+    assert result.completed
+    for x, y, *_ in result.trace.reshape(-1, len(TRACE_FIELDS)):
+        assert disk_is_free(world.occupied, x, y, 0.5, 1.0, False)
+    assert np.abs(result.trace[:, :, 3]).sum() > 0.0
+
+
+def test_objectives_behind_a_wall_are_reached_through_its_door():
+    # A wall across the domain with a 4-unit door at one end: half the domain lies behind it.
+    wall = [[[0.0, 19.0], [26.0, 19.0], [26.0, 21.0], [0.0, 21.0]]]
+    scenario = validate(
+        {"domain": [30.0, 40.0], "obstacles": wall, "robot_radius": 0.4, "agents": 1, "seed": 2, "max_time": 2000.0}
+    )
+    result = run_scenario(scenario)
+    assert result.completed
+    ys = result.trace[:, 0, 1]
+    assert ys.min() < 19.0 and ys.max() > 21.0  # it went to both sides, through the door
+    crossings = result.trace[np.abs(ys - 20.0) < 1.0, 0, 0]
+    assert (crossings > 26.0).all()  # and only through the door
+
+
+def test_an_enclosed_room_is_reported_and_the_run_still_completes():
+    from tests.test_world import CLOSED_ROOM
+
+    scenario = validate(
+        {"domain": [30.0, 30.0], "obstacles": CLOSED_ROOM, "robot_radius": 0.4, "agents": 3, "max_time": 2000.0}
+    )
+    result = run_scenario(scenario)
+    assert result.completed and result.errors[-1] == 0.0
+    summary = summary_of(result)
+    assert summary["terrain"]["unreachable_cells"] == 36
+    assert (result.final_lack[12:18, 12:18] == 0.0).all()  # the room is out of Υ, not covered
+    assert "36 free but unreachable" in format_summary(summary)

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from model.fixed_point import COVERAGE_SCALE
-from model.ground import NO_POSITIONS, open_ground
+from model.ground import NO_POSITIONS, Ground, open_ground
 from model.metrics import total_sensing_ability
 from model.sensing import lack_of_coverage, sense_wedge, sensing_ability
 
@@ -92,3 +92,49 @@ def test_delta_window_lies_inside_grid_and_is_non_negative(x, y, theta):
     if ticks.size:
         assert row0 >= 0 and col0 >= 0
         assert row0 + ticks.shape[0] <= 100 and col0 + ticks.shape[1] <= 100
+
+
+def _ground(occupied: np.ndarray, radius: float = 0.0, occlusion: bool = True) -> Ground:
+    return Ground(occupied, ~occupied, radius, radius, False, bool(occupied.any()), occlusion, 20)
+
+
+def _ticks_at(window: tuple, row: int, col: int) -> int:
+    _, _, _, row0, col0, ticks = window
+    inside = 0 <= row - row0 < ticks.shape[0] and 0 <= col - col0 < ticks.shape[1]
+    return int(ticks[row - row0, col - col0]) if inside else 0
+
+
+def test_a_camera_does_not_see_through_a_wall():
+    coverage = np.zeros((40, 40), dtype=np.int64)
+    wall = np.zeros((40, 40), dtype=bool)
+    wall[15:25, 15] = True  # a wall across the view, 5 cells ahead
+    pose = (10.5, 20.5, 0.0)
+    behind, beside = (20, 20), (20, 12)  # row, col: 10 cells ahead behind the wall; 2 cells ahead before it
+    open_view = sense_wedge(
+        coverage, TARGET, *pose, R, F, ALPHA, 0.1, 1.0, _ground(np.zeros_like(wall)), NO_POSITIONS, 0
+    )
+    walled = sense_wedge(coverage, TARGET, *pose, R, F, ALPHA, 0.1, 1.0, _ground(wall), NO_POSITIONS, 0)
+    assert _ticks_at(open_view, *behind) > 0 and _ticks_at(walled, *behind) == 0
+    assert _ticks_at(walled, *beside) == _ticks_at(open_view, *beside) > 0
+    assert walled[0] < open_view[0]  # hidden cells count in the wedge with nothing to cover there
+    unhidden = sense_wedge(
+        coverage, TARGET, *pose, R, F, ALPHA, 0.1, 1.0, _ground(wall, occlusion=False), NO_POSITIONS, 0
+    )
+    assert _ticks_at(unhidden, *behind) == _ticks_at(open_view, *behind)  # occlusion = false: as before
+
+
+def test_two_robots_hide_each_other():
+    coverage = np.zeros((40, 40), dtype=np.int64)
+    nothing = np.zeros((40, 40), dtype=bool)
+    positions = np.array([[10.5, 20.5], [15.5, 20.5]])  # robot 1 stands 5 units ahead of robot 0
+    behind_1, behind_0 = (20, 20), (20, 5)
+    first = sense_wedge(coverage, TARGET, 10.5, 20.5, 0.0, R, F, ALPHA, 0.1, 1.0, _ground(nothing, 1.0), positions, 0)
+    second = sense_wedge(
+        coverage, TARGET, 15.5, 20.5, math.pi, R, F, ALPHA, 0.1, 1.0, _ground(nothing, 1.0), positions, 1
+    )
+    assert _ticks_at(first, *behind_1) == 0 and _ticks_at(second, *behind_0) == 0
+    point_robots = sense_wedge(
+        coverage, TARGET, 10.5, 20.5, 0.0, R, F, ALPHA, 0.1, 1.0, _ground(nothing, 0.0), positions, 0
+    )
+    assert _ticks_at(point_robots, *behind_1) > 0  # r = 0 hides nothing
+    assert _ticks_at(first, 20, 13) > 0  # what lies before the teammate is seen

@@ -111,3 +111,27 @@ def test_agent_with_bad_id_fails_with_a_clear_message():
     done = anicov("agent", "--id", "7", "--n", "4", "--connect", "tcp/127.0.0.1:1", "--team", "x", timeout=60)
     assert done.returncode == 2
     assert "--id: expected an agent id from 0 to 3, got 7" in done.stderr
+
+
+def test_a_team_on_a_map_equals_the_engine_and_its_recording_shows_the_map(tmp_path):
+    import numpy as np
+
+    from logger.replay import summarise_recording
+    from tests.conftest import write_map
+
+    occupied = np.zeros((40, 40), dtype=bool)
+    occupied[20, :30] = True  # a wall with a 10-unit gap at one end
+    occupied[30:36, 5:11] = True  # and a block
+    write_map(tmp_path, "site", occupied)
+    config = write_scenario(tmp_path / "s.toml", map="site.yaml", agents=3, seed=2, robot_radius=0.4)
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+    assert engine.returncode == 0, engine.stderr
+    team = unique_team()
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), team=team))
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "coverage        complete" in launched.stdout and "terrain" in launched.stdout
+    assert_same_run(tmp_path / "engine", tmp_path / "team")
+    summary = json.loads((tmp_path / "team" / "summary.json").read_text())
+    assert summary["terrain"]["occupied_cells"] == int(occupied.sum()) and summary["terrain"]["map_sha256"]
+    assert "/world/map/occupancy" in summarise_recording(tmp_path / "team" / "recording.rrd", load_maps=False).entities
+    assert processes_of(team) == []
