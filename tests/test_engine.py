@@ -134,3 +134,21 @@ def test_an_enclosed_room_is_reported_and_the_run_still_completes():
     assert summary["terrain"]["unreachable_cells"] == 36
     assert (result.final_lack[12:18, 12:18] == 0.0).all()  # the room is out of Υ, not covered
     assert "36 free but unreachable" in format_summary(summary)
+
+
+def test_a_priority_map_asks_less_where_it_is_dark_and_the_run_still_completes(tmp_path):
+    import cv2
+
+    image = np.full((30, 30), 255, dtype=np.uint8)
+    image[:, :15] = 0  # the left half needs only lambda_star_min
+    cv2.imwrite(str(tmp_path / "priority.png"), image)
+    base = {"domain": [30.0, 30.0], "agents": 2, "seed": 1, "max_time": 3000.0}
+    uniform = run_scenario(validate({**base, "lambda_star": 100.0}))
+    priority = validate(
+        {**base, "lambda_star": "priority.png", "lambda_star_min": 25.0, "lambda_star_max": 100.0}, tmp_path
+    )
+    result = run_scenario(priority)
+    assert uniform.completed and result.completed and result.errors[-1] == 0.0
+    assert result.completion_time < uniform.completion_time
+    summary = summary_of(result)
+    assert summary["optimum_time"] == pytest.approx(summary_of(uniform)["optimum_time"] * (0.5 * 0.25 + 0.5))
