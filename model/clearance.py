@@ -63,12 +63,86 @@ def step_or_stay(
 def swept_disk_is_free(
     occupied: np.ndarray, x0: float, y0: float, x1: float, y1: float, radius: float, cell: float, bounded: bool
 ) -> bool:
-    """Whether the disk stays free along the segment (x0, y0) → (x1, y1), tested every quarter of the
-    smaller of the cell and the radius (a straight drive toward a waypoint, in steps shorter than that)."""
-    spacing = 0.25 * min(cell, radius) if radius > 0.0 else 0.25 * cell
-    samples = max(1, math.ceil(math.hypot(x1 - x0, y1 - y0) / spacing))
-    for k in range(1, samples + 1):
+    """Whether the disk stays free along the segment (x0, y0) → (x1, y1), exactly: no occupied cell's
+    square comes closer than ``radius`` to the segment (and, ``bounded``, both ends keep the disk on the
+    grid, which then holds for the whole segment). Only cells within ⌈(radius + cell/4)/cell⌉ of a cell
+    holding a point of the segment sampled every quarter cell can be that close: those are tested."""
+    rows, cols = occupied.shape
+    if bounded and not (_on_grid(x0, y0, radius, rows, cols, cell) and _on_grid(x1, y1, radius, rows, cols, cell)):
+        return False
+    reach = max(1, math.ceil((radius + 0.25 * cell) / cell))
+    length = math.hypot(x1 - x0, y1 - y0)
+    # Cells along the segment, sampled every quarter cell: every cell it passes through is visited.
+    samples = max(1, math.ceil(4.0 * length / cell))
+    last_row, last_col = -(10**9), -(10**9)
+    for k in range(samples + 1):
         t = k / samples
-        if not disk_is_free(occupied, x0 + t * (x1 - x0), y0 + t * (y1 - y0), radius, cell, bounded):
-            return False
+        row, col = math.floor((y0 + t * (y1 - y0)) / cell), math.floor((x0 + t * (x1 - x0)) / cell)
+        if row == last_row and col == last_col:
+            continue
+        last_row, last_col = row, col
+        for r in range(max(row - reach, 0), min(row + reach + 1, rows)):
+            for c in range(max(col - reach, 0), min(col + reach + 1, cols)):
+                if occupied[r, c] and _segment_square_distance2(
+                    x0, y0, x1, y1, c * cell, r * cell, (c + 1) * cell, (r + 1) * cell
+                ) < max(radius * radius, 1e-300):
+                    return False
+    return True
+
+
+@njit(cache=True)
+def _on_grid(x: float, y: float, radius: float, rows: int, cols: int, cell: float) -> bool:
+    return x - radius >= 0.0 and y - radius >= 0.0 and x + radius <= cols * cell and y + radius <= rows * cell
+
+
+@njit(cache=True)
+def _segment_square_distance2(
+    x0: float, y0: float, x1: float, y1: float, left: float, bottom: float, right: float, top: float
+) -> float:
+    """Squared distance between a segment and a closed axis-aligned square (0 when they meet)."""
+    if _segment_meets_box(x0, y0, x1, y1, left, bottom, right, top):
+        return 0.0
+    best = min(
+        _point_box_distance2(x0, y0, left, bottom, right, top), _point_box_distance2(x1, y1, left, bottom, right, top)
+    )
+    for corner_x, corner_y in ((left, bottom), (right, bottom), (left, top), (right, top)):
+        best = min(best, _point_segment_distance2(corner_x, corner_y, x0, y0, x1, y1))
+    return best
+
+
+@njit(cache=True)
+def _point_box_distance2(x: float, y: float, left: float, bottom: float, right: float, top: float) -> float:
+    gap_x = max(left - x, 0.0, x - right)
+    gap_y = max(bottom - y, 0.0, y - top)
+    return gap_x * gap_x + gap_y * gap_y
+
+
+@njit(cache=True)
+def _point_segment_distance2(px: float, py: float, x0: float, y0: float, x1: float, y1: float) -> float:
+    dx, dy = x1 - x0, y1 - y0
+    length2 = dx * dx + dy * dy
+    t = 0.0 if length2 == 0.0 else max(0.0, min(1.0, ((px - x0) * dx + (py - y0) * dy) / length2))
+    ex, ey = x0 + t * dx - px, y0 + t * dy - py
+    return ex * ex + ey * ey
+
+
+@njit(cache=True)
+def _segment_meets_box(
+    x0: float, y0: float, x1: float, y1: float, left: float, bottom: float, right: float, top: float
+) -> bool:
+    """Liang–Barsky: whether the segment has a point in the closed box."""
+    t0, t1 = 0.0, 1.0
+    dx, dy = x1 - x0, y1 - y0
+    for p, q in ((-dx, x0 - left), (dx, right - x0), (-dy, y0 - bottom), (dy, top - y0)):
+        if p == 0.0:
+            if q < 0.0:
+                return False
+        else:
+            t = q / p
+            if p < 0.0:
+                t0 = max(t0, t)
+            else:
+                t1 = min(t1, t)
+            if t0 > t1:
+                return False
     return True

@@ -8,7 +8,7 @@
 - The way to follow it (:func:`descent_waypoint`): from the robot's cell, walk down the field to the
   lowest neighbour the graph connects (no corner cutting), up to ``lookahead`` cells, and aim at the
   farthest cell of that walk that a straight drive reaches with the disk free all the way (else the
-  robot's own cell centre); the distance is the field at the robot's cell plus the way to that cell's
+  robot's own cell centre; the walk's cells are tried from the farthest); the distance is the field at the robot's cell plus the way to that cell's
   centre. When a straight drive reaches the objective itself, aim at it, at its straight distance,
   exactly as the paper's eq. 10–11 do in an empty domain.
 """
@@ -115,6 +115,8 @@ def descent_waypoint(
     if not math.isfinite(field[row, col]):
         return math.hypot(objective_x - x, objective_y - y), objective_x, objective_y  # cut off: head straight
     waypoint_x, waypoint_y = (col + 0.5) * cell, (row + 0.5) * cell
+    walk = np.empty((lookahead, 2), dtype=np.int64)
+    steps = 0
     for _ in range(lookahead):
         best_row, best_col, best = row, col, field[row, col]
         for k in range(8):
@@ -129,10 +131,13 @@ def descent_waypoint(
         if best_row == row and best_col == col:
             break  # the goal cell
         row, col = best_row, best_col
-        centre_x, centre_y = (col + 0.5) * cell, (row + 0.5) * cell
-        if not in_sight(occupied, x, y, centre_x, centre_y, cell, radius, bounded):
+        walk[steps, 0], walk[steps, 1] = row, col
+        steps += 1
+    for k in range(steps - 1, -1, -1):  # the farthest first: usually in sight along a corridor
+        centre_x, centre_y = (walk[k, 1] + 0.5) * cell, (walk[k, 0] + 0.5) * cell
+        if in_sight(occupied, x, y, centre_x, centre_y, cell, radius, bounded):
+            waypoint_x, waypoint_y = centre_x, centre_y
             break
-        waypoint_x, waypoint_y = centre_x, centre_y
     start_row = min(max(math.floor(y / cell), 0), rows - 1)
     start_col = min(max(math.floor(x / cell), 0), cols - 1)
     distance = field[start_row, start_col] + math.hypot((start_col + 0.5) * cell - x, (start_row + 0.5) * cell - y)

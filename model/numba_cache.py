@@ -26,6 +26,7 @@ KERNEL_SOURCES = (
     "model/geodesic.py",
     "model/reachability.py",
     "model/wall_law.py",
+    "model/occlusion.py",
     "model/ground.py",
     "model/fixed_point.py",
     "model/coverage_map.py",

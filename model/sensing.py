@@ -17,8 +17,7 @@ The map is a grid of cells of side ``cell``; cell (row, col) has its centre at
 On a terrain with occlusion (:class:`model.ground.Ground`) a cell of the wedge whose centre is hidden
 (:func:`model.visibility.line_of_sight`: a wall or a teammate's disk on the way) stays in S_Ω but, like
 a cell outside the domain, has nothing the camera can cover: no ticks, Υ = 0 in e_Ω and eq. 9. The
-test is skipped when nothing in the wedge's window can hide anything (no occupied cell there, no
-teammate's disk near), so an open stretch of a map costs what the open world costs.
+exact test runs only on cells that something may hide (:mod:`model.occlusion`).
 """
 
 from __future__ import annotations
@@ -31,7 +30,8 @@ from numba import njit
 from model.fixed_point import COVERAGE_SCALE
 from model.geometry import wedge_cell_range
 from model.ground import Ground
-from model.visibility import segment_crosses_occupied, segment_passes_disk
+from model.occlusion import hidden_by_teammates, pseudo_bin, teammates_in_view, wall_shadows
+from model.visibility import segment_crosses_occupied
 
 
 @njit(cache=True)
@@ -79,6 +79,14 @@ def wedge_polar(
 
 
 @njit(cache=True)
+def _delta_window(rows: int, cols: int, row0: int, row1: int, col0: int, col1: int) -> tuple[int, int, np.ndarray]:
+    """The top-left cell and the zeroed ticks of a wedge's delta, its window clipped to the grid."""
+    clip_row0, clip_col0 = max(row0, 0), max(col0, 0)
+    height, width = max(min(row1, rows) - clip_row0, 0), max(min(col1, cols) - clip_col0, 0)
+    return clip_row0, clip_col0, np.zeros((height, width), dtype=np.int64)
+
+
+@njit(cache=True)
 def sense_wedge(
     coverage: np.ndarray,
     target_ticks: int,
@@ -94,20 +102,15 @@ def sense_wedge(
     positions: np.ndarray,
     me: int,
 ) -> tuple[float, float, float, int, int, np.ndarray]:
-    """One pass over agent i's wedge Ω_i: (e_Ω of eq. 6, w_left, w_right of eq. 9, and eq. 3's delta as
-    ticks from cell (row0, col0)); see the module's docstring. ``positions`` (N, 2), every robot's (NaN:
-    unknown; ``me``: this one) is read only with occlusion. The map is only read: deltas are applied later."""
+    """One pass over the wedge Ω_i (see the module): (e_Ω, w_left, w_right, row0, col0, ticks of eq. 3).
+    ``positions`` (N, 2): every robot's (NaN: unknown; ``me``: this one), read only with occlusion."""
     rows, cols = coverage.shape
     row0, row1, col0, col1 = wedge_cell_range(x, y, theta, sensing_range, half_angle, cell)
-    clip_row0, clip_col0 = max(row0, 0), max(col0, 0)
-    height = max(min(row1, rows) - clip_row0, 0)
-    width = max(min(col1, cols) - clip_col0, 0)
-    ticks = np.zeros((height, width), dtype=np.int64)
-    heading_x, heading_y = math.cos(theta), math.sin(theta)
-    cos_half_angle = math.cos(half_angle)
-    tick_scale = dt * COVERAGE_SCALE
-    area_weight = cell * cell / (sensing_range * half_angle)
-    occluded_walls, occluders = _what_may_hide(ground, positions, me, x, y, sensing_range, row0, row1, col0, col1)
+    clip_row0, clip_col0, ticks = _delta_window(rows, cols, row0, row1, col0, col1)
+    heading_x, heading_y, cos_half_angle = math.cos(theta), math.sin(theta), math.cos(half_angle)
+    tick_scale, area_weight = dt * COVERAGE_SCALE, cell * cell / (sensing_range * half_angle)
+    shadows = wall_shadows(ground, x, y, theta, half_angle, sensing_range, cell, row0, row1, col0, col1)
+    teammates, occluding = teammates_in_view(ground, positions, me, x, y, sensing_range), ground.occlusion
     cells_in_wedge, lack_sum, w_left, w_right = 0, 0.0, 0.0, 0.0
     for row in range(row0, row1):
         cy = (row + 0.5) * cell - y
@@ -117,13 +120,21 @@ def sense_wedge(
             distance, offset, across = wedge_polar(
                 cx, cy, heading_x, heading_y, sensing_range, half_angle, cos_half_angle
             )
-            if distance < 0.0:
+            cells_in_wedge += distance >= 0.0
+            if distance < 0.0 or not row_inside or col < 0 or col >= cols:
                 continue
-            cells_in_wedge += 1
-            if not row_inside or col < 0 or col >= cols:
-                continue
-            if (occluded_walls or occluders.shape[0] > 0) and _hidden(ground, occluders, x, y, row, col, cell):
-                continue
+            if occluding:
+                target_x, target_y = (col + 0.5) * cell, (row + 0.5) * cell
+                if teammates.shape[0] > 0 and hidden_by_teammates(teammates, ground.radius, x, y, target_x, target_y):
+                    continue
+                near, beyond = shadows[
+                    :, pseudo_bin(across / (cx * heading_x + cy * heading_y + abs(across) + 1e-300), half_angle)
+                ]
+                if distance * distance > near and (
+                    distance * distance > beyond
+                    or segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell)
+                ):
+                    continue
             ability = sensing_ability(distance, offset, sensing_range, half_angle, alpha_max)
             ticks[row - clip_row0, col - clip_col0] = int(ability * tick_scale + 0.5)
             lack = lack_of_coverage(coverage[row, col], target_ticks)
@@ -136,54 +147,3 @@ def sense_wedge(
                     w_right += weight
     e_omega = lack_sum / cells_in_wedge if cells_in_wedge > 0 else 0.0
     return e_omega, w_left, w_right, clip_row0, clip_col0, ticks
-
-
-@njit(cache=True)
-def _what_may_hide(
-    ground: Ground,
-    positions: np.ndarray,
-    me: int,
-    x: float,
-    y: float,
-    sensing_range: float,
-    row0: int,
-    row1: int,
-    col0: int,
-    col1: int,
-) -> tuple[bool, np.ndarray]:
-    """(an occupied cell lies in the wedge's window, positions of the teammates whose disk reaches the
-    wedge's range): what :func:`sense_wedge` must test; nothing at all without occlusion."""
-    if not ground.occlusion:
-        return False, np.zeros((0, 2))
-    rows, cols = ground.occupied.shape
-    walls = False
-    for row in range(max(row0, 0), min(row1, rows)):
-        for col in range(max(col0, 0), min(col1, cols)):
-            if ground.occupied[row, col]:
-                walls = True
-                break
-        if walls:
-            break
-    near = np.zeros((positions.shape[0], 2))
-    count = 0
-    if ground.radius > 0.0:
-        for k in range(positions.shape[0]):
-            px, py = positions[k, 0], positions[k, 1]
-            gap = math.hypot(px - x, py - y)
-            # Bodies that overlap (closer than 2r: robots that drove through each other, which only the
-            # safety filter prevents) hide nothing from each other: one would otherwise be blind.
-            if k == me or px != px or gap > sensing_range + ground.radius or gap < 2.0 * ground.radius:
-                continue
-            near[count, 0], near[count, 1] = px, py
-            count += 1
-    return walls, near[:count]
-
-
-@njit(cache=True)
-def _hidden(ground: Ground, occluders: np.ndarray, x: float, y: float, row: int, col: int, cell: float) -> bool:
-    """Whether a teammate's disk or an occupied cell lies between (x, y) and the centre of cell (row, col)."""
-    target_x, target_y = (col + 0.5) * cell, (row + 0.5) * cell
-    for k in range(occluders.shape[0]):
-        if segment_passes_disk(x, y, target_x, target_y, occluders[k, 0], occluders[k, 1], ground.radius):
-            return True
-    return segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell)

@@ -5,10 +5,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.clearance import disk_is_free, step_or_stay
+from model.clearance import disk_is_free, step_or_stay, swept_disk_is_free
 
 
 def corridor() -> np.ndarray:
@@ -53,3 +53,17 @@ def test_a_robot_driven_anyhow_in_a_corridor_never_touches_its_walls(x, theta, c
         x, y, theta = step_or_stay(walls, x, y, theta, v, omega, 0.7, radius, 1.0, True)
         assert 10.0 + radius <= y <= 13.0 - radius
         assert disk_is_free(walls, x, y, radius, 1.0, True)
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 2**32 - 1), st.floats(0.05, 1.5))
+def test_the_swept_disk_test_is_exact_against_dense_sampling(seed, radius):
+    rng = np.random.default_rng(seed)
+    occupied = rng.random((12, 12)) < 0.15
+    (x0, y0), (x1, y1) = rng.uniform(0.0, 12.0, (2, 2))
+    samples = [(x0 + t * (x1 - x0), y0 + t * (y1 - y0)) for t in np.linspace(0.0, 1.0, 2001)]
+    free = swept_disk_is_free(occupied, x0, y0, x1, y1, radius, 1.0, False)
+    if free:  # no sample's disk overlaps (a hair smaller, for the touching case)
+        assert all(disk_is_free(occupied, x, y, radius * (1 - 1e-6), 1.0, False) for x, y in samples)
+    else:  # some sample's disk, a hair larger, does
+        assert not all(disk_is_free(occupied, x, y, radius + 0.01, 1.0, False) for x, y in samples)

@@ -1,0 +1,152 @@
+"""What may hide a wedge's cells, found once per sensing pass so that the exact test runs on few cells.
+
+The rule is :mod:`model.visibility`'s; this module only prunes. For walls: a segment from the robot at
+p to a cell centre c crosses an occupied square Q only if c's bearing lies in Q's angular span seen
+from p and c is farther than Q's nearest point. The wedge's bearings (±F, plus a bin each side) are
+cut into SHADOW_BINS bins; each bin keeps the nearest distance of the occupied squares of the wedge's
+window whose angular span (widened by a bin each side) meets it, and, for the bins a bin inside a
+square's span, the distance of its farthest corner: a ray there crosses the square's inside, so a cell
+beyond is hidden without a traversal. Squares farther than R, and squares whose four neighbours are
+occupied (a segment reaches one only through a neighbour, unless it ends there), are left out. A cell nearer than its bin's distance
+cannot be hidden by a wall; the others get the exact traversal. (A segment from p to c stays in the
+window grown to the robot's own cell, which holds both, so squares outside it cannot hide anything.) For teammates: those whose
+disk can reach the wedge, each tested exactly.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from model.ground import Ground
+from model.visibility import segment_passes_disk
+
+SHADOW_BINS = 64
+
+
+@njit(cache=True)
+def wall_shadows(
+    ground: Ground,
+    x: float,
+    y: float,
+    theta: float,
+    half_angle: float,
+    sensing_range: float,
+    cell: float,
+    row0: int,
+    row1: int,
+    col0: int,
+    col1: int,
+) -> np.ndarray:
+    """(2, SHADOW_BINS): per bearing bin (:func:`pseudo_bin`), the squared nearest distance of a wall that
+    may hide cells there, and the squared distance beyond which a wall hides every cell there (+inf: none)."""
+    shadows = np.full((2, SHADOW_BINS), np.inf)
+    if not ground.occlusion:
+        return shadows
+    rows, cols = ground.occupied.shape
+    heading_x, heading_y = math.cos(theta), math.sin(theta)
+    reach2 = sensing_range * sensing_range
+    # The window of the wedge's cells and the robot's own cell: a segment between them stays inside.
+    row0, row1 = min(row0, math.floor(y / cell)), max(row1, math.floor(y / cell) + 1)
+    col0, col1 = min(col0, math.floor(x / cell)), max(col1, math.floor(x / cell) + 1)
+    for row in range(max(row0, 0), min(row1, rows)):
+        for col in range(max(col0, 0), min(col1, cols)):
+            if not ground.occupied[row, col] or _inside_a_wall(ground.occupied, row, col, rows, cols):
+                continue  # a segment reaches a cell inside a wall only through the wall cells around it
+            left, bottom = col * cell - x, row * cell - y
+            gap_x = max(left, 0.0, -left - cell)
+            gap_y = max(bottom, 0.0, -bottom - cell)
+            nearest2 = gap_x * gap_x + gap_y * gap_y
+            if nearest2 > reach2:
+                continue
+            smallest, largest, farthest2, behind = _square_span(left, bottom, cell, heading_x, heading_y)
+            if behind:  # beside the robot: it may hide any bearing, and hides none for sure
+                first, last = 0, SHADOW_BINS - 1
+            else:
+                first, last = pseudo_bin(smallest, half_angle) - 1, pseudo_bin(largest, half_angle) + 1
+            for k in range(max(first, 0), min(last, SHADOW_BINS - 1) + 1):
+                shadows[0, k] = min(shadows[0, k], nearest2)
+            if behind:
+                continue
+            # Bins a bin inside the span: every ray there crosses the square's inside, so a cell beyond
+            # its farthest corner is hidden for sure.
+            for k in range(
+                max(pseudo_bin(smallest, half_angle) + 2, 0),
+                min(pseudo_bin(largest, half_angle) - 2, SHADOW_BINS - 1) + 1,
+            ):
+                shadows[1, k] = min(shadows[1, k], farthest2)
+    return shadows
+
+
+@njit(cache=True)
+def _square_span(
+    left: float, bottom: float, cell: float, heading_x: float, heading_y: float
+) -> tuple[float, float, float, bool]:
+    """(smallest and largest pseudo-angle of the square's corners in front, squared distance of its
+    farthest corner, whether a corner is beside or behind the robot), corners relative to the robot."""
+    smallest, largest, farthest2, behind = math.inf, -math.inf, 0.0, False
+    for corner_x, corner_y in (
+        (left, bottom),
+        (left + cell, bottom),
+        (left, bottom + cell),
+        (left + cell, bottom + cell),
+    ):
+        along = corner_x * heading_x + corner_y * heading_y
+        across = heading_x * corner_y - heading_y * corner_x
+        behind = behind or along <= 0.0
+        if along > 0.0:
+            bearing = across / (along + abs(across))
+            smallest, largest = min(smallest, bearing), max(largest, bearing)
+        farthest2 = max(farthest2, corner_x * corner_x + corner_y * corner_y)
+    return smallest, largest, farthest2, behind
+
+
+@njit(cache=True)
+def _inside_a_wall(occupied: np.ndarray, row: int, col: int, rows: int, cols: int) -> bool:
+    """All four edge neighbours are occupied cells of the grid."""
+    if row == 0 or col == 0 or row == rows - 1 or col == cols - 1:
+        return False
+    return occupied[row - 1, col] and occupied[row + 1, col] and occupied[row, col - 1] and occupied[row, col + 1]
+
+
+@njit(cache=True)
+def pseudo_bin(bearing: float, half_angle: float) -> int:
+    """The bin of a pseudo-angle across / (along + |across|) (monotone in the bearing in front of the
+    robot, and cheaper than an arctangent); the bins cut that of ±F into SHADOW_BINS − 2, one more each side."""
+    edge = math.sin(half_angle) / (math.cos(half_angle) + math.sin(half_angle))
+    width = 2.0 * edge / (SHADOW_BINS - 2)
+    return min(max(math.floor((bearing + edge + width) / width), 0), SHADOW_BINS - 1)
+
+
+@njit(cache=True)
+def teammates_in_view(
+    ground: Ground, positions: np.ndarray, me: int, x: float, y: float, sensing_range: float
+) -> np.ndarray:
+    """Positions of the teammates whose disk can hide part of the wedge. Bodies that overlap this one
+    (closer than 2r: robots that drove through each other, which only a safety filter prevents) hide
+    nothing: a robot inside another would otherwise be blind."""
+    near = np.zeros((positions.shape[0], 2))
+    count = 0
+    if not ground.occlusion or ground.radius <= 0.0:
+        return near[:0]
+    for k in range(positions.shape[0]):
+        px, py = positions[k, 0], positions[k, 1]
+        gap = math.hypot(px - x, py - y)
+        if k == me or px != px or gap > sensing_range + ground.radius or gap < 2.0 * ground.radius:
+            continue
+        near[count, 0], near[count, 1] = px, py
+        count += 1
+    return near[:count]
+
+
+@njit(cache=True)
+def hidden_by_teammates(
+    teammates: np.ndarray, radius: float, x: float, y: float, target_x: float, target_y: float
+) -> bool:
+    """A teammate's disk lies across the segment from (x, y) to the target."""
+    for k in range(teammates.shape[0]):
+        if segment_passes_disk(x, y, target_x, target_y, teammates[k, 0], teammates[k, 1], radius):
+            return True
+    return False

@@ -1,0 +1,38 @@
+"""model.occlusion: the pruning never changes what the rule of model.visibility hides."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from model.fixed_point import COVERAGE_SCALE
+from model.ground import NO_POSITIONS, Ground
+from model.sensing import sense_wedge
+from model.visibility import line_of_sight
+
+R, F, ALPHA, TARGET = 20.0, math.radians(27.0), 50.0, 100 * COVERAGE_SCALE
+
+
+@settings(max_examples=150)
+@given(st.integers(0, 2**32 - 1), st.floats(-math.pi, math.pi), st.sampled_from([0.0, 0.6]))
+def test_the_pruned_wedge_hides_exactly_what_the_rule_hides(seed, theta, radius):
+    rng = np.random.default_rng(seed)
+    occupied = rng.random((40, 40)) < 0.04
+    x, y = rng.uniform(10.0, 30.0, 2)
+    occupied[int(y), int(x)] = False  # the robot never stands in an occupied cell
+    positions = np.array([[x, y], *rng.uniform(0.0, 40.0, (3, 2))])
+    coverage = np.zeros((40, 40), dtype=np.int64)
+    ground = Ground(occupied, ~occupied, radius, radius, False, True, True, 20)
+    blind = ground._replace(occlusion=False)
+    *_, row0, col0, seen = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, positions, 0)
+    *_, row0b, col0b, everything = sense_wedge(
+        coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, blind, NO_POSITIONS, 0
+    )
+    assert (row0, col0, seen.shape) == (row0b, col0b, everything.shape)
+    others = positions[1:][np.hypot(*(positions[1:] - [x, y]).T) >= 2 * radius]  # overlapping bodies hide nothing
+    for i, j in zip(*np.nonzero(everything), strict=True):
+        visible = line_of_sight(occupied, x, y, (col0 + j + 0.5), (row0 + i + 0.5), 1.0, others, radius)
+        assert seen[i, j] == (everything[i, j] if visible else 0)
