@@ -3,7 +3,8 @@
 The rule is :mod:`model.visibility`'s; this module only prunes. For walls: a segment from the robot at
 p to a cell centre c crosses an occupied square Q only if c's bearing lies in Q's angular span seen
 from p and c is farther than Q's nearest point. The wedge's bearings (±F, plus a bin each side) are
-cut into SHADOW_BINS bins; each bin keeps the nearest distance of the occupied squares of the wedge's
+cut into SHADOW_BINS bins; each bin keeps the nearest distance of the occupied squares (and teammates'
+disks, :func:`add_teammate_shadows`) of the wedge's
 window whose angular span (widened by a bin each side) meets it, and, for the bins a bin inside a
 square's span, the distance of its farthest corner: a ray there crosses the square's inside, so a cell
 beyond is hidden without a traversal. Squares farther than R, and squares whose four neighbours are
@@ -150,3 +151,32 @@ def hidden_by_teammates(
         if segment_passes_disk(x, y, target_x, target_y, teammates[k, 0], teammates[k, 1], radius):
             return True
     return False
+
+
+@njit(cache=True)
+def add_teammate_shadows(
+    shadows: np.ndarray, teammates: np.ndarray, radius: float, x: float, y: float, theta: float, half_angle: float
+) -> None:
+    """Mark the bins a teammate's disk may hide, from its nearest point on: the bearings of its two
+    tangents (a bin more each side), all bins for a disk that reaches beside the robot."""
+    for k in range(teammates.shape[0]):
+        dx, dy = teammates[k, 0] - x, teammates[k, 1] - y
+        gap = math.hypot(dx, dy)
+        nearest2 = max(gap - radius, 0.0) ** 2
+        centre = math.atan2(dy, dx) - theta
+        centre = math.atan2(math.sin(centre), math.cos(centre))
+        half = math.asin(min(radius / gap, 1.0))
+        if abs(centre) + half >= 0.5 * math.pi - 1e-9:
+            first, last = 0, SHADOW_BINS - 1
+        else:
+            first = pseudo_bin(_pseudo(centre - half), half_angle) - 1
+            last = pseudo_bin(_pseudo(centre + half), half_angle) + 1
+        for b in range(max(first, 0), min(last, SHADOW_BINS - 1) + 1):
+            shadows[0, b] = min(shadows[0, b], nearest2)
+
+
+@njit(cache=True)
+def _pseudo(angle: float) -> float:
+    """The pseudo-angle of :func:`pseudo_bin` of a bearing in (−90°, 90°)."""
+    slope = math.tan(angle)
+    return slope / (1.0 + abs(slope))

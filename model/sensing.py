@@ -30,7 +30,7 @@ from numba import njit
 from model.fixed_point import COVERAGE_SCALE
 from model.geometry import wedge_cell_range
 from model.ground import Ground
-from model.occlusion import hidden_by_teammates, pseudo_bin, teammates_in_view, wall_shadows
+from model.occlusion import add_teammate_shadows, hidden_by_teammates, pseudo_bin, teammates_in_view, wall_shadows
 from model.visibility import segment_crosses_occupied
 
 
@@ -111,6 +111,7 @@ def sense_wedge(
     tick_scale, area_weight = dt * COVERAGE_SCALE, cell * cell / (sensing_range * half_angle)
     shadows = wall_shadows(ground, x, y, theta, half_angle, sensing_range, cell, row0, row1, col0, col1)
     teammates, occluding = teammates_in_view(ground, positions, me, x, y, sensing_range), ground.occlusion
+    add_teammate_shadows(shadows, teammates, ground.radius, x, y, theta, half_angle)
     cells_in_wedge, lack_sum, w_left, w_right = 0, 0.0, 0.0, 0.0
     for row in range(row0, row1):
         cy = (row + 0.5) * cell - y
@@ -124,17 +125,16 @@ def sense_wedge(
             if distance < 0.0 or not row_inside or col < 0 or col >= cols:
                 continue
             if occluding:
-                target_x, target_y = (col + 0.5) * cell, (row + 0.5) * cell
-                if teammates.shape[0] > 0 and hidden_by_teammates(teammates, ground.radius, x, y, target_x, target_y):
-                    continue
+                distance2 = distance * distance
                 near, beyond = shadows[
                     :, pseudo_bin(across / (cx * heading_x + cy * heading_y + abs(across) + 1e-300), half_angle)
                 ]
-                if distance * distance > near and (
-                    distance * distance > beyond
-                    or segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell)
-                ):
-                    continue
+                if distance2 > near:
+                    target_x, target_y = (col + 0.5) * cell, (row + 0.5) * cell
+                    if distance2 > beyond or hidden_by_teammates(teammates, ground.radius, x, y, target_x, target_y):
+                        continue
+                    if segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell):
+                        continue
             ability = sensing_ability(distance, offset, sensing_range, half_angle, alpha_max)
             ticks[row - clip_row0, col - clip_col0] = int(ability * tick_scale + 0.5)
             lack = lack_of_coverage(coverage[row, col], target_ticks)
