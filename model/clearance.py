@@ -40,6 +40,25 @@ def disk_is_free(occupied: np.ndarray, x: float, y: float, radius: float, cell: 
 
 
 @njit(cache=True)
+def clearance_within(occupied: np.ndarray, x: float, y: float, radius: float, cell: float, bounded: bool) -> float:
+    """The distance from (x, y) to the nearest occupied square (and, ``bounded``, the grid's edge), or
+    ``radius`` if nothing is that close."""
+    rows, cols = occupied.shape
+    nearest = radius
+    if bounded:
+        nearest = max(min(nearest, x, y, cols * cell - x, rows * cell - y), 0.0)
+    col0, col1 = max(math.floor((x - radius) / cell) - 1, 0), min(math.floor((x + radius) / cell) + 1, cols - 1)
+    row0, row1 = max(math.floor((y - radius) / cell) - 1, 0), min(math.floor((y + radius) / cell) + 1, rows - 1)
+    for row in range(row0, row1 + 1):
+        for col in range(col0, col1 + 1):
+            if occupied[row, col]:
+                gap_x = max(col * cell - x, 0.0, x - (col + 1) * cell)
+                gap_y = max(row * cell - y, 0.0, y - (row + 1) * cell)
+                nearest = min(nearest, math.sqrt(gap_x * gap_x + gap_y * gap_y))
+    return nearest
+
+
+@njit(cache=True)
 def step_or_stay(
     occupied: np.ndarray,
     x: float,

@@ -22,7 +22,7 @@ from numba import njit
 from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from model.clearance import disk_is_free, swept_disk_is_free
+from model.clearance import clearance_within, disk_is_free, swept_disk_is_free
 from model.visibility import segment_crosses_occupied
 
 NEIGHBOURS = ((0, 1), (1, 0), (0, -1), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
@@ -86,9 +86,13 @@ def in_sight(
     radius: float,
     bounded: bool,
 ) -> bool:
-    """A straight drive from (x, y) to the target crosses no occupied cell and keeps the disk free."""
+    """A straight drive from (x, y) to the target crosses no occupied cell and keeps the disk of ``radius``
+    free, or, where the robot already stands closer to a wall than that, a disk of its clearance there:
+    a robot inside the planning margin may still drive on (else every drive would be refused there,
+    and its waypoint would jump between cells from one step to the next)."""
     if segment_crosses_occupied(occupied, x, y, target_x, target_y, cell):
         return False
+    radius = clearance_within(occupied, x, y, radius, cell, bounded)
     return radius <= 0.0 or swept_disk_is_free(occupied, x, y, target_x, target_y, radius, cell, bounded)
 
 

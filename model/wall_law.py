@@ -7,9 +7,12 @@
   it is uncovered, else the nearest uncovered cell within R in clear sight. (An objective moved into
   the team's space, or on a cell's edge where the robot may stand, may lie beside the blob it stands
   for; Algorithm 1 drops it only once its cell is covered.)
-- A wall is in the way: the heading is toward the waypoint of the shortest free path
+- A wall is in the way and the robot is more than a cell away by path: the heading is toward the
+  waypoint of the shortest free path
   (:func:`model.geodesic.descent_waypoint`) and u_glo comes from that path's length, without eq. 10's
-  stop at R/2 (:func:`model.control.global_law_around_walls`).
+  stop at R/2 (:func:`model.control.global_law_around_walls`). Within a cell by path of an objective
+  it cannot drive straight to (one on a cell's corner by a wall), the robot has arrived: it stops and
+  looks, as above.
 """
 
 from __future__ import annotations
@@ -55,9 +58,10 @@ def global_law_among_walls(
         ground.plan_radius,
         ground.bounded,
     )
-    if waypoint_x != objective_x or waypoint_y != objective_y:
+    detour = waypoint_x != objective_x or waypoint_y != objective_y
+    if detour and distance > cell:
         return global_law_around_walls(x, y, waypoint_x, waypoint_y, distance, literal_heading)
-    if u_glo >= 0.0:
+    if not detour and u_glo >= 0.0:
         return u_glo, theta_glo
     look_x, look_y = uncovered_to_look_at(
         coverage, target_ticks, ground.occupied, x, y, objective_x, objective_y, sensing_range, cell
