@@ -19,11 +19,9 @@ from typing import Any
 import numpy as np
 
 from anicov.engine import run_scenario
-from model.metrics import optimum_time, total_sensing_ability
 from model.scenario import PAPER_SCENARIO, Scenario, load_scenario
-from model.world import world_of
 from runtime.plots import plot_coverage_maps
-from runtime.rundir import covered_area
+from runtime.rundir import summary_of
 
 MAPS = ("warehouse", "office", "field")
 SCENARIOS = PAPER_SCENARIO.parent
@@ -32,14 +30,12 @@ GOAL = 1.5
 
 
 def _one_run(scenario: Scenario) -> dict[str, Any]:
-    result = run_scenario(scenario, record_trace=False)
-    ability = total_sensing_ability(scenario.range, scenario.half_angle, scenario.alpha_max)
-    optimum = optimum_time(covered_area(world_of(scenario)), scenario.lambda_star, ability, scenario.agents)
+    summary = summary_of(run_scenario(scenario, record_trace=False))
     return {
         "seed": scenario.seed,
-        "completed": result.completed,
-        "ratio": result.completion_time / optimum if result.completed else None,
-        "team_path": float(result.path_lengths.sum()),
+        "completed": summary["completed"],
+        "ratio": summary["time_ratio"],
+        "team_path": summary["team_path_length"],
     }
 
 

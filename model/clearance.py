@@ -31,9 +31,7 @@ def disk_is_free(occupied: np.ndarray, x: float, y: float, radius: float, cell: 
             if not occupied[row, col]:
                 continue
             # Distance from the centre to the cell's closed square.
-            gap_x = max(col * cell - x, 0.0, x - (col + 1) * cell)
-            gap_y = max(row * cell - y, 0.0, y - (row + 1) * cell)
-            distance2 = gap_x * gap_x + gap_y * gap_y
+            distance2 = _point_box_distance2(x, y, col * cell, row * cell, (col + 1) * cell, (row + 1) * cell)
             if distance2 == 0.0 or distance2 < radius * radius:
                 return False
     return True
@@ -52,9 +50,8 @@ def clearance_within(occupied: np.ndarray, x: float, y: float, radius: float, ce
     for row in range(row0, row1 + 1):
         for col in range(col0, col1 + 1):
             if occupied[row, col]:
-                gap_x = max(col * cell - x, 0.0, x - (col + 1) * cell)
-                gap_y = max(row * cell - y, 0.0, y - (row + 1) * cell)
-                nearest = min(nearest, math.sqrt(gap_x * gap_x + gap_y * gap_y))
+                distance2 = _point_box_distance2(x, y, col * cell, row * cell, (col + 1) * cell, (row + 1) * cell)
+                nearest = min(nearest, math.sqrt(distance2))
     return nearest
 
 

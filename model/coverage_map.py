@@ -60,7 +60,7 @@ class CoverageMap:
         self.coverage[...] = head_start
         self.uncovered_cells = int((head_start < self.target_ticks).sum())
         self.deficit_ticks = int(np.maximum(self.target_ticks - head_start, 0).sum())
-        self.counted_cells = int((head_start < self.target_ticks).sum())
+        self.counted_cells = self.uncovered_cells  # a fresh map: every cell still to cover counts
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -142,10 +142,7 @@ def descent_waypoint(
         if in_sight(occupied, x, y, centre_x, centre_y, cell, radius, bounded):
             waypoint_x, waypoint_y = centre_x, centre_y
             break
-    start_row = min(max(math.floor(y / cell), 0), rows - 1)
-    start_col = min(max(math.floor(x / cell), 0), cols - 1)
-    distance = field[start_row, start_col] + math.hypot((start_col + 0.5) * cell - x, (start_row + 0.5) * cell - y)
-    return distance, waypoint_x, waypoint_y
+    return length_by_field(field, x, y, cell), waypoint_x, waypoint_y
 
 
 @njit(cache=True)
@@ -163,9 +160,15 @@ def path_length(
 ) -> float:
     """Length of the shortest free path from (x, y) to the goal: ``straight`` (its straight distance)
     when a straight drive gets there, else the goal's field at the robot's cell plus the way to that
-    cell's centre (as :func:`descent_waypoint` measures it); +inf when the goal cannot be reached."""
+    cell's centre (:func:`length_by_field`, as :func:`descent_waypoint` measures it); +inf when the goal cannot be reached."""
     if in_sight(occupied, x, y, goal_x, goal_y, cell, radius, bounded):
         return straight
+    return length_by_field(field, x, y, cell)
+
+
+@njit(cache=True)
+def length_by_field(field: np.ndarray, x: float, y: float, cell: float) -> float:
+    """The field at the cell of (x, y) plus the way from (x, y) to that cell's centre."""
     rows, cols = field.shape
     row = min(max(math.floor(y / cell), 0), rows - 1)
     col = min(max(math.floor(x / cell), 0), cols - 1)

@@ -22,7 +22,6 @@ import numpy as np
 from numba import njit
 
 from model.ground import Ground
-from model.visibility import segment_passes_disk
 
 SHADOW_BINS = 64
 
@@ -140,17 +139,6 @@ def teammates_in_view(
         near[count, 0], near[count, 1] = px, py
         count += 1
     return near[:count]
-
-
-@njit(cache=True)
-def hidden_by_teammates(
-    teammates: np.ndarray, radius: float, x: float, y: float, target_x: float, target_y: float
-) -> bool:
-    """A teammate's disk lies across the segment from (x, y) to the target."""
-    for k in range(teammates.shape[0]):
-        if segment_passes_disk(x, y, target_x, target_y, teammates[k, 0], teammates[k, 1], radius):
-            return True
-    return False
 
 
 @njit(cache=True)

@@ -30,8 +30,8 @@ from numba import njit
 from model.fixed_point import COVERAGE_SCALE
 from model.geometry import wedge_cell_range
 from model.ground import Ground
-from model.occlusion import add_teammate_shadows, hidden_by_teammates, pseudo_bin, teammates_in_view, wall_shadows
-from model.visibility import segment_crosses_occupied
+from model.occlusion import add_teammate_shadows, pseudo_bin, teammates_in_view, wall_shadows
+from model.visibility import hidden_by_teammates, segment_crosses_occupied
 
 
 @njit(cache=True)

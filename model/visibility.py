@@ -102,7 +102,17 @@ def line_of_sight(
 ) -> bool:
     """The rule of the module's docstring: nothing occupied and no teammate's disk between the robot at
     (x, y) and the point (target_x, target_y). ``others``: (K, 2) positions of the other robots."""
-    for k in range(others.shape[0]):
-        if segment_passes_disk(x, y, target_x, target_y, others[k, 0], others[k, 1], radius):
-            return False
+    if hidden_by_teammates(others, radius, x, y, target_x, target_y):
+        return False
     return not segment_crosses_occupied(occupied, x, y, target_x, target_y, cell)
+
+
+@njit(cache=True)
+def hidden_by_teammates(
+    teammates: np.ndarray, radius: float, x: float, y: float, target_x: float, target_y: float
+) -> bool:
+    """A teammate's disk (``teammates``: (K, 2) positions) lies across the segment from (x, y) to the target."""
+    for k in range(teammates.shape[0]):
+        if segment_passes_disk(x, y, target_x, target_y, teammates[k, 0], teammates[k, 1], radius):
+            return True
+    return False

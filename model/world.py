@@ -53,18 +53,18 @@ class World:
         """The paper's world: nothing to test, every run exactly as before terrain existed."""
         return not self.scenario.has_terrain
 
-    @property
+    @functools.cached_property
     def ground(self) -> Ground:
+        """Built once: the engine, the planner and the agent read it every step or plan."""
         scenario = self.scenario
         walls = bool(self.occupied.any())
         occlusion = scenario.occlusion and (bool(self.occupied.any()) or scenario.robot_radius > 0.0)
         lookahead = max(1, math.ceil(scenario.range / scenario.cell))
-        plan_radius = scenario.robot_radius + PLANNING_MARGIN * scenario.cell
         return Ground(
             self.occupied,
             self.passable,
             scenario.robot_radius,
-            plan_radius,
+            plan_radius_of(scenario),
             bool(scenario.map),
             walls,
             occlusion,
@@ -113,6 +113,11 @@ class World:
         if self.priority_sha256:
             report["priority_sha256"] = self.priority_sha256
         return report
+
+
+def plan_radius_of(scenario: Scenario) -> float:
+    """The robot's radius plus the planning margin: what passable cells and straight drives keep free."""
+    return scenario.robot_radius + PLANNING_MARGIN * scenario.cell
 
 
 def team_space(passable: np.ndarray, cell: float) -> np.ndarray:
@@ -166,8 +171,7 @@ def world_of(scenario: Scenario) -> World:
     if occupied.all():
         raise TerrainError(f"{where} has no free cell")
     bounded = bool(scenario.map)
-    plan_radius = scenario.robot_radius + PLANNING_MARGIN * scenario.cell
-    passable = passable_cells(occupied, plan_radius, scenario.cell, bounded)
+    passable = passable_cells(occupied, plan_radius_of(scenario), scenario.cell, bounded)
     reachable = team_space(passable, scenario.cell)
     if not reachable.any():
         raise TerrainError(f"{where}: no free place holds a robot of radius {scenario.robot_radius}")
