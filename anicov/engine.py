@@ -21,9 +21,10 @@ from numba.typed import List
 
 from model.coverage_map import CoverageMap, add_window
 from model.ground import Ground, open_ground
-from model.parameters import coverage_map_of, law_parameters, starting_poses
+from model.parameters import coverage_map_of, law_parameters, safety_parameters, starting_poses
 from model.planning import Plan, Planner
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack, snapshot_steps
+from model.safety import SafetyParameters, filter_command
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move, sense_only
 from model.world import World, world_of
@@ -38,20 +39,26 @@ def advance_team(
     law: LawParameters,
     ground: Ground,
     fields: np.ndarray,
+    safety: SafetyParameters,
+    memory: np.ndarray,
     steps: int,
     uncovered: int,
     deficit: int,
     total_deficit: int,
     trace: np.ndarray,
     errors: np.ndarray,
+    flags: np.ndarray,
 ) -> tuple[int, int, int]:
     """Run up to ``steps`` steps of the paper's law for the whole team; stop early at full coverage.
 
-    ``fields[i]``: the distance field of agent i's objective (terrain only). Writes the per-step trace
-    (TRACE_FIELDS) and e_D after each step; returns (steps done, uncovered cells, deficit ticks).
+    ``fields[i]``: the distance field of agent i's objective (terrain only). With ``safety`` enabled every
+    command passes through the filter (model.safety), from the poses at t_k, with ``memory`` (N, 2) its
+    deadlock state. Writes the per-step trace (TRACE_FIELDS), the filter's flags and e_D after each step;
+    returns (steps done, uncovered cells, deficit ticks).
     """
     agents = poses.shape[0]
     positions = np.empty((agents, 2))
+    fresh, teammates = np.zeros(agents), np.zeros(agents, dtype=np.int64)  # lockstep: every pose is t_k's
     for step in range(steps):
         positions[:, 0] = poses[:, 0]
         positions[:, 1] = poses[:, 1]
@@ -62,6 +69,10 @@ def advance_team(
                 coverage, x, y, theta, objectives[i, 0], objectives[i, 1], law, ground, fields[i], positions, i
             )
             windows.append((row0, col0, ticks))
+            if safety.enabled:
+                v, omega, flags[step, i] = filter_command(
+                    v, omega, i, poses, fresh, teammates, ground, law.cell, safety, memory[i]
+                )
             trace[step, i, 0] = x
             trace[step, i, 1] = y
             trace[step, i, 2] = theta
@@ -94,6 +105,7 @@ def run_scenario(
     if scenario.controller == "zigzag":
         return _run_zigzag(scenario, coverage_map, poses, record_trace, progress)
     law, world = law_parameters(scenario, coverage_map), world_of(scenario)
+    safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, 2), dtype=np.int64)
     planner = Planner(scenario)
     block = scenario.replan_steps
     agents = scenario.agents
@@ -102,6 +114,8 @@ def run_scenario(
     snapshot_times, snapshots = [0.0], [quantised_lack(coverage_map.lack_of_coverage())]
     scratch_trace = np.zeros((block, agents, len(TRACE_FIELDS)))
     scratch_errors = np.zeros(block)
+    scratch_flags = np.zeros((block, agents), dtype=np.uint8)
+    flags: list[np.ndarray] = []
     steps_done = 0
     plans: list[Plan] = []
     next_snapshot = SNAPSHOT_PERIOD
@@ -118,13 +132,17 @@ def run_scenario(
             law,
             world.ground,
             objective_fields(world, objectives),
+            safety,
+            memory,
             steps,
             coverage_map.uncovered_cells,
             coverage_map.deficit_ticks,
             coverage_map.target_ticks * coverage_map.counted_cells,
             scratch_trace,
             scratch_errors,
+            scratch_flags,
         )
+        flags.append(scratch_flags[:done].copy())
         if record_trace:
             traces.append(scratch_trace[:done].copy())
         else:
@@ -140,6 +158,7 @@ def run_scenario(
             progress(now, coverage_map.domain_error())
     result = _finish(scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace)
     result.plans = plans
+    result.safety_flags = np.concatenate(flags) if flags else np.zeros((0, agents), dtype=np.uint8)
     return result
 
 

@@ -179,7 +179,7 @@ class Coordinator:
         if members and (
             step % self.scenario.replan_steps == 0 or self.membership_changed or len(self.targets) != len(members)
         ):
-            self.targets = self.planner.plan(self.replica.map.lack_of_coverage(), positions)
+            self.targets = self.planner.plan(self.replica.map.lack_of_coverage(), positions, members)
             self.membership_changed = False
             return Objectives(step, tuple(members), self.targets, self.planner.blobs.positions, self.planner.labels())
         return Objectives(step, tuple(members), self.targets, self.planner.blobs.positions)

@@ -28,6 +28,8 @@ KERNEL_SOURCES = (
     "model/wall_law.py",
     "model/occlusion.py",
     "model/ground.py",
+    "model/safety.py",
+    "model/barrier_qp.py",
     "model/fixed_point.py",
     "model/coverage_map.py",
     "anicov/engine.py",

@@ -11,6 +11,7 @@ import numpy as np
 
 from model.clearance import disk_is_free
 from model.coverage_map import CoverageMap
+from model.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
 from model.step import LawParameters
 from model.world import world_of
@@ -66,14 +67,17 @@ def free_initial_poses(
     radius: float,
     clearance: float,
     reachable: np.ndarray | None = None,
+    spacing: float | None = None,
+    clear_edges: bool = False,
 ) -> np.ndarray:
     """Poses (N, 3) drawn from ``seed`` as :func:`initial_poses` draws them (all x, all y, all θ, over
     the grid's extent), keeping each robot whose disk is on the grid, ``clearance`` away from occupied
-    cells, at least 2·radius + clearance from the robots kept before it, and (given ``reachable``) in a
-    reachable cell; the others are drawn again, in rounds, in id order. On a grid with no occupied cell
+    cells (and, ``clear_edges``, from the grid's edge), at least 2·radius + ``spacing`` (default: clearance)
+    from the robots kept before it, and (given ``reachable``) in a reachable cell; the others are drawn again, in rounds, in id order. On a grid with no occupied cell
     and point robots every pose is kept at once: the poses are exactly :func:`initial_poses`'s. Raises
     ValueError when the free space cannot hold the team."""
     rng = np.random.default_rng(seed)
+    spacing = clearance if spacing is None else spacing
     rows, cols = occupied.shape
     poses = np.zeros((agents, 3))
     placed: list[int] = []
@@ -86,8 +90,8 @@ def free_initial_poses(
         thetas = rng.uniform(-math.pi, math.pi, len(pending))
         still: list[int] = []
         for agent, x, y, theta in zip(pending, xs, ys, thetas, strict=True):
-            if _start_is_free(occupied, cell, x, y, radius, clearance, reachable) and all(
-                math.hypot(x - poses[other, 0], y - poses[other, 1]) >= 2.0 * radius + clearance for other in placed
+            if _start_is_free(occupied, cell, x, y, radius, clearance, reachable, clear_edges) and all(
+                math.hypot(x - poses[other, 0], y - poses[other, 1]) >= 2.0 * radius + spacing for other in placed
             ):
                 poses[agent] = (x, y, theta)
                 placed.append(agent)
@@ -101,12 +105,19 @@ def free_initial_poses(
 
 
 def _start_is_free(
-    occupied: np.ndarray, cell: float, x: float, y: float, radius: float, clearance: float, reachable: np.ndarray | None
+    occupied: np.ndarray,
+    cell: float,
+    x: float,
+    y: float,
+    radius: float,
+    clearance: float,
+    reachable: np.ndarray | None,
+    clear_edges: bool,
 ) -> bool:
     rows, cols = occupied.shape
     if not disk_is_free(occupied, x, y, radius, cell, True):
         return False
-    if clearance > 0.0 and not disk_is_free(occupied, x, y, radius + clearance, cell, False):
+    if clearance > 0.0 and not disk_is_free(occupied, x, y, radius + clearance, cell, clear_edges):
         return False
     return reachable is None or bool(reachable[min(int(y / cell), rows - 1), min(int(x / cell), cols - 1)])
 
@@ -118,10 +129,45 @@ START_CLEARANCE = 0.5
 def starting_poses(scenario: Scenario) -> np.ndarray:
     """The team's poses at t_0: :func:`initial_poses` in the open world; on a terrain drawn in the team's
     space, clear of walls and of each other (:func:`free_initial_poses`). ValueError: no room."""
+    if scenario.initial_poses:
+        return np.array([(x, y, math.radians(theta)) for x, y, theta in scenario.initial_poses])
     world = world_of(scenario)
     if world.open:
         return initial_poses(scenario)
-    clearance = START_CLEARANCE * scenario.cell
+    clearance = spacing = START_CLEARANCE * scenario.cell
+    if scenario.filters:  # every barrier holds at t_0 (model.safety): points 2r + s + 2l apart, r + s + l off walls
+        clearance = max(clearance, scenario.safety_margin + 2.0 * scenario.lookahead)
+        spacing = max(spacing, scenario.safety_margin + 4.0 * scenario.lookahead)
     return free_initial_poses(
-        world.occupied, scenario.cell, scenario.agents, scenario.seed, scenario.robot_radius, clearance, world.reachable
+        world.occupied,
+        scenario.cell,
+        scenario.agents,
+        scenario.seed,
+        scenario.robot_radius,
+        clearance,
+        world.reachable,
+        spacing,
+        clear_edges=scenario.filters and world.ground.bounded,
+    )
+
+
+def safety_parameters(scenario: Scenario) -> SafetyParameters:
+    """The safety filter's constants (model.safety); disabled for point robots or ``safety = false``."""
+    if not scenario.filters:
+        return disabled_safety()
+    omega_max = math.pi * scenario.k_omega
+    point_speed = math.hypot(scenario.k_v, scenario.lookahead * omega_max)
+    return SafetyParameters(
+        enabled=True,
+        radius=scenario.robot_radius,
+        margin=scenario.safety_margin,
+        lookahead=scenario.lookahead,
+        decay=min(1.0, scenario.barrier_gain * scenario.dt),
+        reach=scenario.safety_range,
+        v_max=scenario.k_v,
+        omega_max=omega_max,
+        dt=scenario.dt,
+        point_speed=point_speed,
+        slack=point_speed * omega_max * scenario.dt**2 / 2.0,
+        max_pose_age=scenario.max_pose_age,
     )

@@ -27,12 +27,17 @@ class Planner:
     scenario: Scenario
     blobs: BlobObjectives = field(default_factory=BlobObjectives)
 
-    def plan(self, lack: np.ndarray, positions: np.ndarray) -> np.ndarray:
-        """Objective (x, y) for every agent, shape (N, 2).
+    def plan(self, lack: np.ndarray, positions: np.ndarray, members: list[int] | None = None) -> np.ndarray:
+        """Objective (x, y) for every agent (``members``, by id; default all, in id order), shape (N, 2).
+
+        A scenario with fixed ``objectives`` gives each robot its own, Algorithms 1–2 do not run.
 
         On a terrain Algorithm 1 runs on the same Υ (cells nobody can cover are at Λ* already), each
         objective is then moved into the team's space (:func:`model.reachability.nearest_reachable`)
         and Algorithm 2 takes the lengths of the shortest free paths to them (:func:`path_lengths`)."""
+        if self.scenario.objectives:
+            ids = range(len(positions)) if members is None else members
+            return np.array([self.scenario.objectives[agent] for agent in ids], dtype=np.float64).reshape(-1, 2)
         self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range)
         objectives = self.blobs.positions
         if len(objectives) == 0:

@@ -49,6 +49,7 @@ class RunResult:
     final_lack: np.ndarray
     plan_time: float | None = None  # zig-zag only: when the last lane was finished
     plans: list[Plan] = field(default_factory=list)  # every replan, for the recording
+    safety_flags: np.ndarray | None = None  # (steps, N) uint8: what the safety filter did (model.safety)
 
     @property
     def path_lengths(self) -> np.ndarray:

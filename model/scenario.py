@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from model.scenario_safety import SAFETY_DEFAULTS, SafetyKeyError, check_safety, resolve_safety_key
 from model.scenario_terrain import resolve_terrain_keys
 from model.terrain import TerrainError
 
@@ -54,6 +55,15 @@ class Scenario:
     occlusion: bool = True  # walls and teammates' disks hide what lies behind them
     priority_map: str = ""  # an image whose grey level gives Λ*(x) from lambda_star_min to lambda_star
     lambda_star_min: float = 0.0
+    # Safety (issue 12, model/scenario_safety.py): the filter acts only on robots with a body.
+    safety: bool = True
+    safety_margin: float = 0.2
+    lookahead: float = 0.2
+    barrier_gain: float = 5.0
+    safety_range: float = 5.0
+    max_pose_age: float = 0.5
+    initial_poses: tuple[tuple[float, float, float], ...] = ()  # (x, y, θ in degrees) per robot
+    objectives: tuple[tuple[float, float], ...] = ()  # fixed, instead of Algorithms 1-2
 
     @property
     def half_angle(self) -> float:
@@ -82,11 +92,22 @@ class Scenario:
         for key in TERRAIN_KEYS:
             if getattr(self, key) == getattr(_OPEN_WORLD, key) or (key == "occlusion" and not self.has_terrain):
                 del values[key]
+        for key in SAFETY_DEFAULTS:
+            unused = key not in ("initial_poses", "objectives") and not self.robot_radius > 0.0
+            if getattr(self, key) == SAFETY_DEFAULTS[key] or unused:
+                del values[key]
+            elif key in ("initial_poses", "objectives"):
+                values[key] = [list(point) for point in getattr(self, key)]
         if self.priority_map:
             values["lambda_star"] = values.pop("priority_map")
             values["lambda_star_max"] = self.lambda_star
             values["lambda_star_min"] = self.lambda_star_min
         return values
+
+    @property
+    def filters(self) -> bool:
+        """Commands pass through the safety filter: robots with a body and ``safety`` on."""
+        return self.safety and self.robot_radius > 0.0
 
     @property
     def has_terrain(self) -> bool:
@@ -137,6 +158,11 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
     for key, value in values.items():
         if key in TERRAIN_KEYS:
             resolved[key] = value
+        elif key in SAFETY_DEFAULTS:
+            try:
+                resolved[key] = resolve_safety_key(key, value)
+            except SafetyKeyError as error:
+                raise ScenarioError(str(error)) from error
         elif key == "domain":
             if not isinstance(value, list | tuple) or len(value) != 2:
                 raise ScenarioError(f"scenario key 'domain': expected [width, height], got {value!r}")
@@ -174,6 +200,10 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
             "scenario key 'controller': 'zigzag' flies the open domain's lanes and knows no walls or robot "
             "bodies; with map, obstacles or robot_radius use one of paper, paper-literal, paper-eq16"
         )
+    try:
+        check_safety(scenario)
+    except SafetyKeyError as error:
+        raise ScenarioError(str(error)) from error
     rows, cols = scenario.grid_shape
     for axis, cells, size in (("width", cols, scenario.domain[0]), ("height", rows, scenario.domain[1])):
         if cells < 1 or abs(cells * scenario.cell - size) > 1e-9 * size:

@@ -1,0 +1,258 @@
+"""The safety filter (issue 12): between the coverage law and the robot, the command nearest the law's
+that keeps robots apart and off the walls, from one robot's own view. Rules in docs/safety.md.
+
+Formulation: barrier certificates on a look-ahead point, as the Robotarium's
+(Wang, Ames & Egerstedt, "Safety barrier certificates for collisions-free multirobot systems", IEEE
+T-RO 33(3), 2017; Robotarium rps ``create_uni_barrier_certificate``), in the discrete-time form of
+Agrawal & Sreenath (RSS 2017), with each robot taking half of each pair's constraint (decentralised).
+
+* The point p = c + l·(cos θ, sin θ) ahead of the centre c moves as a single integrator:
+  ṗ = u = v·e + l·ω·e⊥, so z = (v, l·ω) is u in the robot's frame and |u − û| = |z − ẑ|.
+* Over one step with (v, ω) held, p moves by Δ = dt·sinc(ω·dt/2)·R(ω·dt/2)·u; |Δ − u·dt| ≤ ε with
+  ε = u_max·ω_max·dt²/2 (the slack).
+* Robot pair: h = |p_i − p_j| − D, D = 2r + s + 2l (+ how far a teammate's point may have moved since
+  its pose was sent). With n = (p_i − p_j)/|p_i − p_j|, |p'_i − p'_j| ≥ n·(p'_i − p'_j), so if each robot
+  keeps n·Δ_i ≥ −½·γ·h, then h_{k+1} ≥ (1 − γ)·h_k ≥ 0: the points stay D apart, the centres 2r + s.
+  Each robot imposes n·u ≥ (−½·γ·h + ε)/dt on itself.
+* Wall cell (a closed square) or map edge: q its point nearest p, n = (p − q)/|p − q|: the whole cell lies
+  behind the line through q normal to n, so the same argument with the whole of γ (a wall does not move)
+  keeps the point r + s + l from every wall, the disk s from it: n·u ≥ (−γ·h + ε)/dt.
+* Velocity bounds of the paper: |v| ≤ k_v, |ω| ≤ π·k_ω (eq. 15–16), as four more half-planes.
+* The QP min |z − ẑ|² over them is solved exactly (:mod:`model.barrier_qp`); if it is empty the robot
+  stops (v = ω = 0: Δ = 0 keeps its half of every constraint), as the Robotarium's does.
+
+Deadlock (a robot held still by a teammate for ``STUCK_STEPS`` steps): the standard remedy of a
+rotation bias (the "keep right" rule, Wang et al. 2017, Sec. VI; Grover et al. 2016): the nominal
+velocity is turned by ``KEEP_RIGHT`` to the robot's right until the law's own command passes the filter
+again (resolved) or ``DETOUR_STEPS`` have gone (given up; it may be found again).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from model.barrier_qp import project_onto_polygon
+from model.ground import Ground
+
+FILTER_CHANGED = 1  # the command differs from the law's
+KEEPING_RIGHT = 2  # a deadlock's detour is under way
+NO_SAFE_COMMAND = 4  # the QP was empty: stopped
+STALE_NEIGHBOUR = 8  # a teammate in range sent no pose for max_pose_age: stopped
+DEADLOCK_FOUND = 16  # held by a teammate for STUCK_STEPS: the detour starts
+DEADLOCK_RESOLVED = 32  # the law's command passes again after a detour
+
+STUCK_STEPS = 10
+"""Steps a robot may be held by a teammate (moving at under HELD_FRACTION of the law's speed) before
+it is called a deadlock."""
+HELD_FRACTION = 0.25
+WANTS_TO_MOVE = 0.05
+"""A robot held is one whose law asks for more than this fraction of k_v."""
+KEEP_RIGHT = math.radians(60.0)
+DETOUR_STEPS = 100
+"""The most steps one detour lasts before it is given up."""
+
+TEAMMATE, PARKED = 0, 1
+"""How a teammate takes part: it filters too (half of each constraint each), or it no longer moves
+(its process died: the whole constraint is this robot's)."""
+
+
+class SafetyParameters(NamedTuple):
+    """The filter's constants, from the scenario (:func:`model.parameters.safety_parameters`)."""
+
+    enabled: bool
+    radius: float  # r
+    margin: float  # s
+    lookahead: float  # l
+    decay: float  # γ = min(1, barrier_gain·dt): h_{k+1} ≥ (1 − γ)·h_k
+    reach: float  # safety_range: teammates farther (centre to centre) are left out
+    v_max: float  # k_v
+    omega_max: float  # π·k_ω
+    dt: float
+    point_speed: float  # u_max = sqrt(k_v² + (l·ω_max)²): the fastest a look-ahead point moves
+    slack: float  # ε = u_max·ω_max·dt²/2
+    max_pose_age: float  # a teammate's pose older than this, in range: stop
+
+
+def disabled_safety() -> SafetyParameters:
+    """No filter: the paper's robots (and any run with point robots or ``safety = false``)."""
+    return SafetyParameters(False, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0, math.inf)
+
+
+@njit(cache=True)
+def _add(gx, gy, c, count, nx, ny, theta, bound):
+    """The half-plane n·u ≥ bound, written in z: n·u = z_v·(n·e) + z_l·(n·e⊥)."""
+    cos_t, sin_t = math.cos(theta), math.sin(theta)
+    gx[count] = nx * cos_t + ny * sin_t
+    gy[count] = -nx * sin_t + ny * cos_t
+    c[count] = bound
+    return count + 1
+
+
+@njit(cache=True)
+def _pair_bound(distance: float, clearance: float, share: float, safety: SafetyParameters) -> float:
+    """The least n·u for a barrier h = distance − clearance, this robot taking ``share`` of it."""
+    return (-share * safety.decay * (distance - clearance) + safety.slack) / safety.dt
+
+
+@njit(cache=True)
+def _teammates(gx, gy, c, count, px, py, theta, me, poses, ages, kinds, safety):
+    """Constraints from the teammates within reach; (count, any live teammate too old, count before)."""
+    ahead = safety.lookahead
+    stale = False
+    for j in range(poses.shape[0]):
+        if j == me or not math.isfinite(poses[j, 0]):
+            continue
+        spread = safety.point_speed * ages[j]  # where its point may be by now
+        centre_distance = math.hypot(poses[me, 0] - poses[j, 0], poses[me, 1] - poses[j, 1])
+        if centre_distance - spread > safety.reach:
+            continue
+        if kinds[j] == TEAMMATE and ages[j] > safety.max_pose_age:
+            stale = True
+        qx, qy = poses[j, 0] + ahead * math.cos(poses[j, 2]), poses[j, 1] + ahead * math.sin(poses[j, 2])
+        dx, dy = px - qx, py - qy
+        distance = math.hypot(dx, dy)
+        if distance > 0.0:
+            nx, ny = dx / distance, dy / distance
+        else:  # one point on the other: back off
+            nx, ny = -math.cos(theta), -math.sin(theta)
+        clearance = 2.0 * safety.radius + safety.margin + 2.0 * ahead + spread
+        share = 0.5 if kinds[j] == TEAMMATE else 1.0
+        count = _add(gx, gy, c, count, nx, ny, theta, _pair_bound(distance, clearance, share, safety))
+    return count, stale
+
+
+@njit(cache=True)
+def _walls(gx, gy, c, count, px, py, theta, occupied, cell, bounded, safety):
+    """Constraints from the occupied cells (and, on a map, its edges) a step could bring within reach."""
+    clearance = safety.radius + safety.margin + safety.lookahead
+    band = clearance + 2.0 * safety.point_speed * safety.dt  # farther cells cannot be reached this step
+    rows, cols = occupied.shape
+    if bounded:
+        for nx, ny, distance in (
+            (1.0, 0.0, px),
+            (0.0, 1.0, py),
+            (-1.0, 0.0, cols * cell - px),
+            (0.0, -1.0, rows * cell - py),
+        ):
+            if distance <= band:
+                count = _add(gx, gy, c, count, nx, ny, theta, _pair_bound(distance, clearance, 1.0, safety))
+    col0, col1 = max(math.floor((px - band) / cell), 0), min(math.floor((px + band) / cell), cols - 1)
+    row0, row1 = max(math.floor((py - band) / cell), 0), min(math.floor((py + band) / cell), rows - 1)
+    for row in range(row0, row1 + 1):
+        for col in range(col0, col1 + 1):
+            if not occupied[row, col]:
+                continue
+            qx = min(max(px, col * cell), (col + 1) * cell)  # the square's point nearest p
+            qy = min(max(py, row * cell), (row + 1) * cell)
+            dx, dy = px - qx, py - qy
+            distance = math.hypot(dx, dy)
+            if distance > band:
+                continue
+            if distance > 0.0:
+                nx, ny = dx / distance, dy / distance
+            else:
+                nx, ny = -math.cos(theta), -math.sin(theta)
+            count = _add(gx, gy, c, count, nx, ny, theta, _pair_bound(distance, clearance, 1.0, safety))
+    return count
+
+
+@njit(cache=True)
+def safe_velocities(
+    v_hat: float,
+    omega_hat: float,
+    me: int,
+    poses: np.ndarray,
+    ages: np.ndarray,
+    kinds: np.ndarray,
+    ground: Ground,
+    cell: float,
+    safety: SafetyParameters,
+    turn: float,
+) -> tuple[float, float, bool, bool, bool]:
+    """The QP for robot ``me`` at ``poses[me]``: the safe (v, ω) nearest the law's (v̂, ω̂), whose
+    velocity is first turned by ``turn`` (a detour). Returns (v, ω, feasible, a teammate binds the law's
+    command, a live teammate in reach is older than max_pose_age)."""
+    x, y, theta = poses[me, 0], poses[me, 1], poses[me, 2]
+    ahead = safety.lookahead
+    px, py = x + ahead * math.cos(theta), y + ahead * math.sin(theta)
+    window = math.ceil(2.0 * (safety.radius + safety.margin + ahead + 2.0 * safety.point_speed * safety.dt) / cell) + 2
+    capacity = 8 + poses.shape[0] + window * window
+    gx, gy, c = np.zeros(capacity), np.zeros(capacity), np.zeros(capacity)
+    # The paper's bounds |v| ≤ k_v, |ω| ≤ π·k_ω, in z = (v, l·ω).
+    gx[0], gx[1], gy[2], gy[3] = 1.0, -1.0, 1.0, -1.0
+    c[0] = c[1] = -safety.v_max
+    c[2] = c[3] = -ahead * safety.omega_max
+    first_teammate = count = 4
+    count, stale = _teammates(gx, gy, c, count, px, py, theta, me, poses, ages, kinds, safety)
+    binding = False
+    for k in range(first_teammate, count):
+        binding = binding or gx[k] * v_hat + gy[k] * ahead * omega_hat < c[k]
+    count = _walls(gx, gy, c, count, px, py, theta, ground.occupied, cell, ground.bounded, safety)
+    target_v = math.cos(turn) * v_hat - math.sin(turn) * ahead * omega_hat
+    target_l = math.sin(turn) * v_hat + math.cos(turn) * ahead * omega_hat
+    feasible, v, lw = project_onto_polygon(gx, gy, c, count, target_v, target_l)
+    return v, lw / ahead, feasible, binding, stale
+
+
+@njit(cache=True)
+def filter_command(
+    v_hat: float,
+    omega_hat: float,
+    me: int,
+    poses: np.ndarray,
+    ages: np.ndarray,
+    kinds: np.ndarray,
+    ground: Ground,
+    cell: float,
+    safety: SafetyParameters,
+    memory: np.ndarray,
+) -> tuple[float, float, int]:
+    """The command robot ``me`` applies, and what the filter did (the flag bits above).
+
+    ``poses`` (N, 3): every robot's last known pose, this one's current; ``ages`` (N,): how old each is
+    (0 in lockstep); ``kinds``: TEAMMATE or PARKED; ``memory`` (2,): steps held so far and steps of the
+    detour under way, updated in place (the engine and the agent both keep it, so lockstep agrees)."""
+    v, omega, feasible, binding, stale = safe_velocities(
+        v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
+    )
+    if stale:
+        memory[0] = 0
+        return 0.0, 0.0, STALE_NEIGHBOUR
+    flags = 0
+    if memory[1] > 0:  # on a detour: back on the law's command once it passes the filter
+        if feasible and not _held(v_hat, omega_hat, v, omega, binding, safety):
+            memory[1] = 0
+            flags |= DEADLOCK_RESOLVED
+        elif memory[1] >= DETOUR_STEPS:
+            memory[1] = 0
+        else:
+            memory[1] += 1
+            flags |= KEEPING_RIGHT
+            v, omega, feasible, _, _ = safe_velocities(
+                v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, -KEEP_RIGHT
+            )
+    elif binding and _held(v_hat, omega_hat, v if feasible else 0.0, omega if feasible else 0.0, binding, safety):
+        memory[0] += 1
+        if memory[0] >= STUCK_STEPS:
+            memory[0] = 0
+            memory[1] = 1
+            flags |= DEADLOCK_FOUND
+    else:
+        memory[0] = 0
+    if not feasible:
+        return 0.0, 0.0, flags | NO_SAFE_COMMAND
+    if abs(v - v_hat) + safety.lookahead * abs(omega - omega_hat) > 1e-12 * (1.0 + abs(v_hat)):
+        flags |= FILTER_CHANGED
+    return v, omega, flags
+
+
+@njit(cache=True)
+def _held(v_hat: float, omega_hat: float, v: float, omega: float, binding: bool, safety: SafetyParameters) -> bool:
+    """A teammate's constraint binds and the robot moves at under HELD_FRACTION of what its law asks."""
+    ahead = safety.lookahead
+    asked = math.hypot(v_hat, ahead * omega_hat)
+    return binding and asked > WANTS_TO_MOVE * safety.v_max and math.hypot(v, ahead * omega) < HELD_FRACTION * asked
