@@ -6,12 +6,17 @@ opens one, feeds this class what arrives and publishes what it returns.
 from __future__ import annotations
 
 import logging
+import time
 from dataclasses import dataclass
+
+import numpy as np
 
 from agents.robot import Robot, SimulatedUnicycle
 from model.coverage_map import load_kernels as load_map_kernels
 from model.ground import NO_FIELD
-from model.parameters import law_parameters, starting_poses
+from model.parameters import law_parameters, safety_parameters, starting_poses
+from model.safety import PARKED, TEAMMATE, filter_command
+from model.safety import load_kernels as load_safety_kernels
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, load_kernels
 from model.world import world_of
@@ -47,8 +52,14 @@ class AgentNode:
         self.world = world_of(scenario)
         self.ground = self.world.ground
         starts = starting_poses(scenario)
-        # Every robot's last known position, for the line-of-sight test: all start where the seed puts them.
+        # Every robot's last known pose, for the line-of-sight test and the safety filter: all start where
+        # the seed puts them. Realtime, the filter also needs how old each is (scenario time units).
+        self.poses = starts.copy()
         self.positions = starts[:, :2].copy()
+        self.heard_at = np.full(scenario.agents, time.monotonic())
+        self.kinds = np.full(scenario.agents, TEAMMATE, dtype=np.int64)  # PARKED once a teammate's process is gone
+        self.safety = safety_parameters(scenario)
+        self.safety_memory = np.zeros(2, dtype=np.int64)  # the filter's deadlock state (model.safety)
         self.robot = robot or SimulatedUnicycle(tuple(starts[options.agent]), self.law, self.ground)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=1000 + options.agent)
         self.step = 0
@@ -81,6 +92,8 @@ class AgentNode:
                 self.gos[message.step] = message
             self.started = True
         elif isinstance(message, Objectives):
+            if not self.started:
+                self.heard_at[:] = time.monotonic()  # realtime: the team starts moving now
             self.take_targets(message)
             self.started = True
         elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
@@ -96,6 +109,8 @@ class AgentNode:
         logs it (a dead teammate's lost deltas then come from the relays, see protocol.recovery.fill_gaps)."""
         if change.agent == self.options.agent:
             return
+        if 0 <= change.agent < len(self.kinds):
+            self.kinds[change.agent] = TEAMMATE if change.alive else PARKED  # a dead robot's base stops
         if change.alive:
             if change.agent in self.teammates_left:
                 log.info("agent %d: teammate %d is back", self.options.agent, change.agent)
@@ -122,6 +137,8 @@ class AgentNode:
         """A teammate's pose at the end of its step (lockstep: every member's, at the start of this step)."""
         if 0 <= state.agent < len(self.positions) and state.agent != self.options.agent:
             self.positions[state.agent] = state.next_pose[:2]
+            self.poses[state.agent] = state.next_pose
+            self.heard_at[state.agent] = time.monotonic()
 
     def take_targets(self, objectives: Objectives) -> None:
         target = objectives.target_of(self.options.agent)
@@ -196,16 +213,39 @@ class AgentNode:
         v, omega, e_omega, row0, col0, ticks = decide_and_sense(
             self.replica.map.coverage, *pose, *self.objective, self.law, self.ground, field, self.positions, me
         )
+        flags = 0
+        if self.safety.enabled:
+            self.poses[me] = pose
+            v, omega, flags = filter_command(
+                v,
+                omega,
+                me,
+                self.poses,
+                self.pose_ages(),
+                self.kinds,
+                self.ground,
+                self.law.cell,
+                self.safety,
+                self.safety_memory,
+            )
         delta = MapDelta(self.options.agent, self.step, row0, col0, ticks)
         self.replica.apply(delta)
         next_pose = self.robot.command(v, omega)
-        state = AgentState(self.options.agent, self.step, pose, v, omega, e_omega, next_pose)
+        state = AgentState(self.options.agent, self.step, pose, v, omega, e_omega, next_pose, flags)
         self.step += 1
         return delta, state
+
+    def pose_ages(self) -> np.ndarray:
+        """How old each teammate's pose is, in scenario time: 0 in lockstep (every pose is t_k's, from the
+        go); realtime, the wall time since it arrived, at the run's speed."""
+        if self.options.clock == "lockstep":
+            return np.zeros(len(self.poses))
+        return (time.monotonic() - self.heard_at) * self.options.speed
 
     def load_kernels(self) -> None:
         """numba's kernels loaded while the team gathers (see model.step.load_kernels)."""
         load_kernels(self.replica.map.coverage, self.robot.pose(), self.law, self.ground)
+        load_safety_kernels(self.safety, self.ground, self.law.cell, self.scenario.agents)
         load_map_kernels()
 
     def hello(self) -> AgentState:

@@ -160,14 +160,14 @@ def wait_for_exit(children: list[Child], timeout: float) -> None:
 def warm_numba_cache(scenario: Scenario) -> None:
     """Compile (or load) the jitted kernels once here, so N children do not all compile at once."""
     from model.coverage_map import load_kernels as load_map_kernels
-    from model.parameters import coverage_map_of, law_parameters, starting_poses
+    from model.parameters import coverage_map_of, law_parameters, safety_parameters, starting_poses
+    from model.safety import load_kernels as load_safety_kernels
     from model.step import load_kernels
     from model.world import world_of
 
-    grid = coverage_map_of(scenario)
-    load_kernels(
-        grid.coverage, tuple(starting_poses(scenario)[0]), law_parameters(scenario, grid), world_of(scenario).ground
-    )
+    grid, ground = coverage_map_of(scenario), world_of(scenario).ground
+    load_kernels(grid.coverage, tuple(starting_poses(scenario)[0]), law_parameters(scenario, grid), ground)
+    load_safety_kernels(safety_parameters(scenario), ground, scenario.cell, scenario.agents)
     load_map_kernels()
 
 

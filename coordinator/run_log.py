@@ -25,6 +25,7 @@ class RunLog:
     snapshots: list[np.ndarray] = field(default_factory=list)
     events: list[str] = field(default_factory=list)
     last_step: dict[int, int] = field(default_factory=dict)
+    safety: dict[int, np.ndarray] = field(default_factory=dict)  # step → (N,) safety filter flags
 
     def record(self, state: AgentState) -> None:
         """Keep a state's trace row and, if it is the agent's latest, its pose at the end of the step."""
@@ -33,6 +34,8 @@ class RunLog:
             if row is None:
                 row = self.rows[state.step] = np.full((self.agents, len(TRACE_FIELDS)), np.nan)
             row[state.agent] = (*state.pose, state.v, state.omega, state.e_omega)
+            if state.safety:
+                self.safety.setdefault(state.step, np.zeros(self.agents, dtype=np.uint8))[state.agent] = state.safety
         if state.step >= self.last_step.get(state.agent, -2):
             self.final_poses[state.agent] = state.next_pose
             self.last_step[state.agent] = state.step
@@ -52,6 +55,10 @@ class RunLog:
         for agent, pose in self.final_poses.items():
             trace[steps, agent, :3] = pose
             trace[steps, agent, 3:] = 0.0
+        flags = np.zeros((steps, self.agents), dtype=np.uint8)
+        for step, row in self.safety.items():
+            if step < steps:
+                flags[step] = row
         return RunResult(
             scenario=scenario,
             completed=completed,
@@ -62,4 +69,5 @@ class RunLog:
             snapshot_times=self.snapshot_times,
             snapshots=self.snapshots,
             final_lack=final_lack,
+            safety_flags=flags,
         )

@@ -30,6 +30,7 @@ KERNEL_SOURCES = (
     "model/ground.py",
     "model/safety.py",
     "model/barrier_qp.py",
+    "model/safety_record.py",
     "model/fixed_point.py",
     "model/coverage_map.py",
     "anicov/engine.py",

@@ -135,8 +135,8 @@ def starting_poses(scenario: Scenario) -> np.ndarray:
     if world.open:
         return initial_poses(scenario)
     clearance = spacing = START_CLEARANCE * scenario.cell
-    if scenario.filters:  # every barrier holds at t_0 (model.safety): points 2r + s + 2l apart, r + s + l off walls
-        clearance = max(clearance, scenario.safety_margin + 2.0 * scenario.lookahead)
+    if scenario.filters:  # every barrier holds at t_0 (model.safety): points 2r + s + 2l apart, disks s off walls
+        clearance = max(clearance, scenario.safety_margin)
         spacing = max(spacing, scenario.safety_margin + 4.0 * scenario.lookahead)
     return free_initial_poses(
         world.occupied,

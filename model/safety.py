@@ -14,9 +14,10 @@ Agrawal & Sreenath (RSS 2017), with each robot taking half of each pair's constr
   its pose was sent). With n = (p_i − p_j)/|p_i − p_j|, |p'_i − p'_j| ≥ n·(p'_i − p'_j), so if each robot
   keeps n·Δ_i ≥ −½·γ·h, then h_{k+1} ≥ (1 − γ)·h_k ≥ 0: the points stay D apart, the centres 2r + s.
   Each robot imposes n·u ≥ (−½·γ·h + ε)/dt on itself.
-* Wall cell (a closed square) or map edge: q its point nearest p, n = (p − q)/|p − q|: the whole cell lies
-  behind the line through q normal to n, so the same argument with the whole of γ (a wall does not move)
-  keeps the point r + s + l from every wall, the disk s from it: n·u ≥ (−γ·h + ε)/dt.
+* Wall cell (a closed square) or map edge: q its point nearest the centre c, n = (c − q)/|c − q|: the whole
+  cell lies behind the line through q normal to n, so h = n·(c − q) − (r + s) ≥ 0 keeps the disk s off it.
+  A wall does not move, so the centre itself carries this barrier, with the whole of γ:
+  v·dt·(n·e) − |v|·dt·κ ≥ −γ·h, κ = ω_max·dt/2 (the arc's turn off its chord), two half-planes in v.
 * Velocity bounds of the paper: |v| ≤ k_v, |ω| ≤ π·k_ω (eq. 15–16), as four more half-planes.
 * The QP min |z − ẑ|² over them is solved exactly (:mod:`model.barrier_qp`); if it is empty the robot
   stops (v = ω = 0: Δ = 0 keeps its half of every constraint), as the Robotarium's does.
@@ -126,37 +127,52 @@ def _teammates(gx, gy, c, count, px, py, theta, me, poses, ages, kinds, safety):
 
 
 @njit(cache=True)
-def _walls(gx, gy, c, count, px, py, theta, occupied, cell, bounded, safety):
-    """Constraints from the occupied cells (and, on a map, its edges) a step could bring within reach."""
-    clearance = safety.radius + safety.margin + safety.lookahead
-    band = clearance + 2.0 * safety.point_speed * safety.dt  # farther cells cannot be reached this step
+def _wall(gx, gy, c, count, nx, ny, distance, theta, safety):
+    """The centre's barrier against one wall point: h = n·(c − q) − (r + s), kept by
+    n·Δc ≥ v·dt·(n·e) − |v|·dt·κ ≥ −γ·h (κ = ω_max·dt/2 bounds the arc's turn off the chord), written as
+    two half-planes in v (one for each sign of v), both held by v = 0 while h ≥ 0."""
+    kappa = 0.5 * safety.omega_max * safety.dt
+    along = nx * math.cos(theta) + ny * math.sin(theta)
+    bound = -safety.decay * (distance - safety.radius - safety.margin) / safety.dt
+    for sign in (-1.0, 1.0):
+        gx[count], gy[count], c[count] = along + sign * kappa, 0.0, bound
+        count += 1
+    return count
+
+
+@njit(cache=True)
+def _walls(gx, gy, c, count, x, y, theta, occupied, cell, bounded, safety):
+    """Constraints from the occupied cells (and, on a map, its edges) one step could bring within reach.
+
+    Walls do not move, so their barrier is on the centre itself (exact, and tight: a barrier on the
+    look-ahead point would keep a robot facing a wall up to 2l farther off it than s). Only v appears
+    in it; the law's ω turns the robot away."""
+    band = safety.radius + safety.margin + 2.0 * safety.v_max * safety.dt  # farther cannot be reached this step
     rows, cols = occupied.shape
     if bounded:
         for nx, ny, distance in (
-            (1.0, 0.0, px),
-            (0.0, 1.0, py),
-            (-1.0, 0.0, cols * cell - px),
-            (0.0, -1.0, rows * cell - py),
+            (1.0, 0.0, x),
+            (0.0, 1.0, y),
+            (-1.0, 0.0, cols * cell - x),
+            (0.0, -1.0, rows * cell - y),
         ):
             if distance <= band:
-                count = _add(gx, gy, c, count, nx, ny, theta, _pair_bound(distance, clearance, 1.0, safety))
-    col0, col1 = max(math.floor((px - band) / cell), 0), min(math.floor((px + band) / cell), cols - 1)
-    row0, row1 = max(math.floor((py - band) / cell), 0), min(math.floor((py + band) / cell), rows - 1)
+                count = _wall(gx, gy, c, count, nx, ny, distance, theta, safety)
+    col0, col1 = max(math.floor((x - band) / cell), 0), min(math.floor((x + band) / cell), cols - 1)
+    row0, row1 = max(math.floor((y - band) / cell), 0), min(math.floor((y + band) / cell), rows - 1)
     for row in range(row0, row1 + 1):
         for col in range(col0, col1 + 1):
             if not occupied[row, col]:
                 continue
-            qx = min(max(px, col * cell), (col + 1) * cell)  # the square's point nearest p
-            qy = min(max(py, row * cell), (row + 1) * cell)
-            dx, dy = px - qx, py - qy
-            distance = math.hypot(dx, dy)
+            qx = min(max(x, col * cell), (col + 1) * cell)  # the square's point nearest the centre
+            qy = min(max(y, row * cell), (row + 1) * cell)
+            distance = math.hypot(x - qx, y - qy)
             if distance > band:
                 continue
             if distance > 0.0:
-                nx, ny = dx / distance, dy / distance
-            else:
-                nx, ny = -math.cos(theta), -math.sin(theta)
-            count = _add(gx, gy, c, count, nx, ny, theta, _pair_bound(distance, clearance, 1.0, safety))
+                count = _wall(gx, gy, c, count, (x - qx) / distance, (y - qy) / distance, distance, theta, safety)
+            else:  # inside a wall (a pose given so): no direction out is known, stay
+                count = _wall(gx, gy, c, count, math.cos(theta), math.sin(theta), 0.0, theta, safety)
     return count
 
 
@@ -179,8 +195,8 @@ def safe_velocities(
     x, y, theta = poses[me, 0], poses[me, 1], poses[me, 2]
     ahead = safety.lookahead
     px, py = x + ahead * math.cos(theta), y + ahead * math.sin(theta)
-    window = math.ceil(2.0 * (safety.radius + safety.margin + ahead + 2.0 * safety.point_speed * safety.dt) / cell) + 2
-    capacity = 8 + poses.shape[0] + window * window
+    window = math.ceil(2.0 * (safety.radius + safety.margin + 2.0 * safety.v_max * safety.dt) / cell) + 2
+    capacity = 8 + poses.shape[0] + 2 * window * window
     gx, gy, c = np.zeros(capacity), np.zeros(capacity), np.zeros(capacity)
     # The paper's bounds |v| ≤ k_v, |ω| ≤ π·k_ω, in z = (v, l·ω).
     gx[0], gx[1], gy[2], gy[3] = 1.0, -1.0, 1.0, -1.0
@@ -191,7 +207,7 @@ def safe_velocities(
     binding = False
     for k in range(first_teammate, count):
         binding = binding or gx[k] * v_hat + gy[k] * ahead * omega_hat < c[k]
-    count = _walls(gx, gy, c, count, px, py, theta, ground.occupied, cell, ground.bounded, safety)
+    count = _walls(gx, gy, c, count, x, y, theta, ground.occupied, cell, ground.bounded, safety)
     target_v = math.cos(turn) * v_hat - math.sin(turn) * ahead * omega_hat
     target_l = math.sin(turn) * v_hat + math.cos(turn) * ahead * omega_hat
     feasible, v, lw = project_onto_polygon(gx, gy, c, count, target_v, target_l)
@@ -256,3 +272,24 @@ def _held(v_hat: float, omega_hat: float, v: float, omega: float, binding: bool,
     ahead = safety.lookahead
     asked = math.hypot(v_hat, ahead * omega_hat)
     return binding and asked > WANTS_TO_MOVE * safety.v_max and math.hypot(v, ahead * omega) < HELD_FRACTION * asked
+
+
+def load_kernels(safety: SafetyParameters, ground: Ground, cell: float, agents: int) -> None:
+    """Have numba load the filter now, with the real argument types, on scratch state (see
+    model.step.load_kernels)."""
+    if not safety.enabled:
+        return
+    poses = np.zeros((agents, 3))
+    poses[:, 0] = np.arange(agents) * 1e3  # nobody near anybody
+    filter_command(
+        0.0,
+        0.0,
+        0,
+        poses,
+        np.zeros(agents),
+        np.zeros(agents, dtype=np.int64),
+        ground,
+        cell,
+        safety,
+        np.zeros(2, dtype=np.int64),
+    )

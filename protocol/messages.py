@@ -7,7 +7,7 @@ Encoding (here) never fails for a well-formed value; decoding
 decode may touch a map or a controller.
 
     MapDelta    agent, seq (= step), window (row0, col0, ticks int64 h×w)   eq. 3
-    AgentState  agent, step, pose at t_k, v, ω, e_Ω, pose at t_k+1 (step −1: hello)
+    AgentState  agent, step, pose at t_k, v, ω, e_Ω, pose at t_k+1 (step −1: hello), safety filter flags
     AgentStep   what an agent publishes each step: its MapDelta and its AgentState
     StepGo      lockstep: step k may start; every member's step k−1 delta and state
     Objectives  step k, members, targets (one per member), blob objectives  Alg. 1–2
@@ -75,6 +75,7 @@ class AgentState:
     omega: float
     e_omega: float
     next_pose: Pose
+    safety: int = 0  # what the safety filter did this step (model.safety flag bits; 0: nothing)
 
 
 @dataclass(frozen=True)
@@ -174,7 +175,7 @@ def _state_body(message: AgentState) -> dict[str, Any]:
         "vel": [message.v, message.omega],
         "e_omega": message.e_omega,
         "next": list(message.next_pose),
-    }
+    } | ({"safety": message.safety} if message.safety else {})
 
 
 def _objectives_body(message: Objectives) -> dict[str, Any]:

@@ -13,6 +13,7 @@ from typing import Any
 from model.fixed_point import COVERAGE_SCALE
 from model.metrics import optimum_time, total_sensing_ability
 from model.run import RunResult
+from model.safety_record import safety_figures
 from model.world import World, world_of
 
 TRAJECTORY_HEADER = "t,agent,x,y,theta,v,omega"
@@ -59,6 +60,8 @@ def summary_of(result: RunResult) -> dict[str, Any]:
         summary["plan_time"] = result.plan_time
     if not world.open or scenario.priority_map:
         summary["terrain"] = world.summary()
+    if scenario.robot_radius > 0.0:  # with the filter on or off, so that the two compare
+        summary |= safety_figures(result.trace[:, :, :2], result.safety_flags, world.ground, scenario.cell)
     return summary
 
 
@@ -99,9 +102,26 @@ def format_summary(summary: dict[str, Any], out_dir: Path | None = None) -> str:
             f"  terrain         {terrain['occupied_cells']} occupied cells, {terrain['coverable_cells']} coverable, "
             f"{terrain['unreachable_cells']} free but unreachable (left out of e_D)"
         )
+    if "min_separation" in summary:
+        lines.append(_safety_line(summary))
     if out_dir is not None:
         lines.append(f"  outputs         {out_dir}/")
     return "\n".join(lines)
+
+
+def _safety_line(summary: dict[str, Any]) -> str:
+    scenario = summary["scenario"]
+    radius = scenario["robot_radius"]
+    separation, clearance = summary["min_separation"], summary["min_clearance"]
+    filtered = "filter on" if scenario.get("safety", True) else "filter OFF"
+    return (
+        f"  safety          {filtered}: min separation "
+        + (f"{separation:.3f} (2r = {2 * radius:g})" if separation is not None else "-")
+        + ", min clearance "
+        + (f"{clearance:.3f} (r = {radius:g})" if clearance is not None else "-")
+        + f", active {100 * summary['filter_active_fraction']:.1f} % of steps, "
+        f"deadlocks {summary['deadlocks_resolved']}/{summary['deadlocks']} resolved"
+    )
 
 
 def write_counts(path: str | Path | None, counts: dict[str, object]) -> None:

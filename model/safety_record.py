@@ -1,0 +1,88 @@
+"""What a run shows of safety (issue 12), from its trace and the filter's flags: the figures summary.json
+reports whenever robots have a body, with the filter on or off (so the two can be compared).
+
+- ``min_separation``: the least distance between two robots' centres, over every step and along the
+  straight line between consecutive poses (the closest approach of two linear motions; a unicycle's arc
+  departs from its chord by at most v·ω·dt²/8, 0.004 units at the paper's gains). Safe: ≥ 2r.
+- ``min_clearance``: the least distance from a centre to an occupied cell (or, on a map, its edge), at
+  every pose of the trace. Safe: ≥ r. None in the open world.
+- ``filter_active_fraction``: the share of agent-steps whose command the filter changed or stopped.
+- ``deadlocks`` / ``deadlocks_resolved``: robots held still by a teammate long enough to start a detour,
+  and the detours that ended with the law's own command passing again (model.safety).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from model.clearance import clearance_within
+from model.ground import Ground
+from model.safety import (
+    DEADLOCK_FOUND,
+    DEADLOCK_RESOLVED,
+    FILTER_CHANGED,
+    KEEPING_RIGHT,
+    NO_SAFE_COMMAND,
+    STALE_NEIGHBOUR,
+)
+
+ACTIVE = FILTER_CHANGED | KEEPING_RIGHT | NO_SAFE_COMMAND | STALE_NEIGHBOUR
+
+
+def min_separation(positions: np.ndarray) -> float | None:
+    """Least centre distance over the (steps, N, 2) positions and the segments between them (NaN rows,
+    steps a realtime trace never heard, are skipped). None with fewer than two robots."""
+    agents = positions.shape[1]
+    if agents < 2 or len(positions) == 0:
+        return None
+    first, second = np.triu_indices(agents, 1)
+    relative = positions[:, first] - positions[:, second]  # (steps, pairs, 2)
+    least = np.nanmin(np.linalg.norm(relative, axis=2)) if np.isfinite(relative).any() else math.inf
+    if len(positions) > 1:
+        start, motion = relative[:-1], relative[1:] - relative[:-1]
+        length2 = np.einsum("spk,spk->sp", motion, motion)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = np.clip(-np.einsum("spk,spk->sp", start, motion) / length2, 0.0, 1.0)
+        t = np.where(length2 > 0.0, t, 0.0)
+        closest = np.linalg.norm(start + t[..., None] * motion, axis=2)
+        if np.isfinite(closest).any():
+            least = min(least, float(np.nanmin(closest)))
+    return float(least) if math.isfinite(least) else None
+
+
+@njit(cache=True)
+def _least_clearance(
+    occupied: np.ndarray, xs: np.ndarray, ys: np.ndarray, cap: float, cell: float, bounded: bool
+) -> float:
+    least = cap
+    for k in range(xs.shape[0]):
+        if math.isfinite(xs[k]) and math.isfinite(ys[k]):
+            least = min(least, clearance_within(occupied, xs[k], ys[k], least, cell, bounded))
+    return least
+
+
+def min_clearance(positions: np.ndarray, ground: Ground, cell: float) -> float | None:
+    """Least distance from a centre to a wall (or a map's edge) over the (steps, N, 2) positions; None
+    when there is neither."""
+    if not ground.occupied.any() and not ground.bounded:
+        return None
+    cap = float(max(ground.occupied.shape) * cell)
+    xs, ys = positions[..., 0].ravel(), positions[..., 1].ravel()
+    return float(_least_clearance(ground.occupied, xs, ys, cap, cell, ground.bounded))
+
+
+def safety_figures(positions: np.ndarray, flags: np.ndarray | None, ground: Ground, cell: float) -> dict[str, object]:
+    """The summary.json safety figures of a run (see the module docstring)."""
+    flags = np.zeros((0, positions.shape[1]), dtype=np.uint8) if flags is None else flags
+    heard = np.isfinite(positions[: len(flags), :, 0]) if len(flags) else np.zeros(flags.shape, dtype=bool)
+    steps = int(heard.sum())
+    return {
+        "min_separation": min_separation(positions),
+        "min_clearance": min_clearance(positions, ground, cell),
+        "filter_active_fraction": float(((flags & ACTIVE) != 0)[heard].sum() / steps) if steps else 0.0,
+        "deadlocks": int(((flags & DEADLOCK_FOUND) != 0).sum()),
+        "deadlocks_resolved": int(((flags & DEADLOCK_RESOLVED) != 0).sum()),
+    }
