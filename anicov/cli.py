@@ -87,6 +87,21 @@ def command_terrain_study(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def command_safety_study(args: argparse.Namespace) -> int:
+    from anicov.reproduce import parse_team_range
+    from anicov.safety_study import MAPS, run_study
+
+    if args.runs < 1:
+        raise ScenarioError(f"--runs: expected a positive number of runs, got {args.runs}")
+    maps = tuple(name for name in args.maps.split(",") if name and name != "none")
+    unknown = sorted(set(maps) - set(MAPS))
+    if unknown:
+        raise ScenarioError(f"--maps: expected names among {', '.join(MAPS)} (or none), got {unknown[0]!r}")
+    run_study(args.runs, parse_team_range(args.teams), Path(args.out), args.workers, maps)
+    print(f"safety study written to {args.out}/safety.md")
+    return EXIT_OK
+
+
 def command_router(args: argparse.Namespace) -> int:
     import zenoh
 
@@ -177,6 +192,14 @@ def _add_in_process_commands(commands: argparse._SubParsersAction) -> None:
     terrain.add_argument("--teams", default="1,4,10", help="team sizes (default 1,4,10)")
     terrain.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
     terrain.set_defaults(handler=command_terrain_study)
+
+    safety = commands.add_parser("safety-study", help="the safety filter on and off, same seeds (issue 12)")
+    safety.add_argument("--out", required=True, help="output directory (docs/safety holds the committed one)")
+    safety.add_argument("--runs", type=int, default=100, help="seeded runs per case (default 100)")
+    safety.add_argument("--teams", default="1-30", help="team sizes on the paper's domain (default 1-30)")
+    safety.add_argument("--maps", default="warehouse,office,field", help="shipped maps, N = 4 and 10 (or none)")
+    safety.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    safety.set_defaults(handler=command_safety_study)
 
 
 def _add_bus_tools(commands: argparse._SubParsersAction) -> None:

@@ -20,7 +20,8 @@ class Ground(NamedTuple):
     occupied: np.ndarray  # bool (rows, cols)
     passable: np.ndarray  # bool (rows, cols): centres that hold the robot's disk
     radius: float  # r
-    plan_radius: float  # r plus PLANNING_MARGIN: what paths and straight drives are planned with
+    plan_radius: float  # wall_clearance plus PLANNING_MARGIN: what paths and straight drives are planned with
+    wall_clearance: float  # r, plus the safety margin s when the filter is on: what the law keeps off walls
     bounded: bool  # the map's edge is a wall
     walls: bool  # an occupied cell: the global law and the assignment go round them
     occlusion: bool  # lines of sight are tested (walls, or teammates' disks when r > 0)
@@ -30,7 +31,7 @@ class Ground(NamedTuple):
 def open_ground() -> Ground:
     """No wall, no body, nothing hidden: the paper's world."""
     nothing = np.zeros((1, 1), dtype=np.bool_)
-    return Ground(nothing, ~nothing, 0.0, 0.0, False, False, False, 1)
+    return Ground(nothing, ~nothing, 0.0, 0.0, 0.0, False, False, False, 1)
 
 
 NO_FIELD = np.zeros((1, 1))

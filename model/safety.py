@@ -37,6 +37,7 @@ import numpy as np
 from numba import njit
 
 from model.barrier_qp import project_onto_polygon
+from model.geometry import wrap_angle
 from model.ground import Ground
 
 FILTER_CHANGED = 1  # the command differs from the law's
@@ -127,7 +128,7 @@ def _teammates(gx, gy, c, count, px, py, theta, me, poses, ages, kinds, safety):
 
 
 @njit(cache=True)
-def _wall(gx, gy, c, count, nx, ny, distance, theta, safety):
+def _wall(gx, gy, c, normals, count, nx, ny, distance, theta, safety):
     """The centre's barrier against one wall point: h = n·(c − q) − (r + s), kept by
     n·Δc ≥ v·dt·(n·e) − |v|·dt·κ ≥ −γ·h (κ = ω_max·dt/2 bounds the arc's turn off the chord), written as
     two half-planes in v (one for each sign of v), both held by v = 0 while h ≥ 0."""
@@ -136,12 +137,13 @@ def _wall(gx, gy, c, count, nx, ny, distance, theta, safety):
     bound = -safety.decay * (distance - safety.radius - safety.margin) / safety.dt
     for sign in (-1.0, 1.0):
         gx[count], gy[count], c[count] = along + sign * kappa, 0.0, bound
+        normals[count, 0], normals[count, 1] = nx, ny
         count += 1
     return count
 
 
 @njit(cache=True)
-def _walls(gx, gy, c, count, x, y, theta, occupied, cell, bounded, safety):
+def _walls(gx, gy, c, normals, count, x, y, theta, occupied, cell, bounded, safety):
     """Constraints from the occupied cells (and, on a map, its edges) one step could bring within reach.
 
     Walls do not move, so their barrier is on the centre itself (exact, and tight: a barrier on the
@@ -157,7 +159,7 @@ def _walls(gx, gy, c, count, x, y, theta, occupied, cell, bounded, safety):
             (0.0, -1.0, rows * cell - y),
         ):
             if distance <= band:
-                count = _wall(gx, gy, c, count, nx, ny, distance, theta, safety)
+                count = _wall(gx, gy, c, normals, count, nx, ny, distance, theta, safety)
     col0, col1 = max(math.floor((x - band) / cell), 0), min(math.floor((x + band) / cell), cols - 1)
     row0, row1 = max(math.floor((y - band) / cell), 0), min(math.floor((y + band) / cell), rows - 1)
     for row in range(row0, row1 + 1):
@@ -170,9 +172,11 @@ def _walls(gx, gy, c, count, x, y, theta, occupied, cell, bounded, safety):
             if distance > band:
                 continue
             if distance > 0.0:
-                count = _wall(gx, gy, c, count, (x - qx) / distance, (y - qy) / distance, distance, theta, safety)
+                count = _wall(
+                    gx, gy, c, normals, count, (x - qx) / distance, (y - qy) / distance, distance, theta, safety
+                )
             else:  # inside a wall (a pose given so): no direction out is known, stay
-                count = _wall(gx, gy, c, count, math.cos(theta), math.sin(theta), 0.0, theta, safety)
+                count = _wall(gx, gy, c, normals, count, math.cos(theta), math.sin(theta), 0.0, theta, safety)
     return count
 
 
@@ -191,7 +195,8 @@ def safe_velocities(
 ) -> tuple[float, float, bool, bool, bool]:
     """The QP for robot ``me`` at ``poses[me]``: the safe (v, ω) nearest the law's (v̂, ω̂), whose
     velocity is first turned by ``turn`` (a detour). Returns (v, ω, feasible, a teammate binds the law's
-    command, a live teammate in reach is older than max_pose_age)."""
+    command, a live teammate in reach is older than max_pose_age, the normal of the wall it presses on
+    most or (0, 0))."""
     x, y, theta = poses[me, 0], poses[me, 1], poses[me, 2]
     ahead = safety.lookahead
     px, py = x + ahead * math.cos(theta), y + ahead * math.sin(theta)
@@ -207,11 +212,18 @@ def safe_velocities(
     binding = False
     for k in range(first_teammate, count):
         binding = binding or gx[k] * v_hat + gy[k] * ahead * omega_hat < c[k]
-    count = _walls(gx, gy, c, count, x, y, theta, ground.occupied, cell, ground.bounded, safety)
+    normals = np.zeros((capacity, 2))
+    first_wall = count
+    count = _walls(gx, gy, c, normals, count, x, y, theta, ground.occupied, cell, ground.bounded, safety)
     target_v = math.cos(turn) * v_hat - math.sin(turn) * ahead * omega_hat
     target_l = math.sin(turn) * v_hat + math.cos(turn) * ahead * omega_hat
     feasible, v, lw = project_onto_polygon(gx, gy, c, count, target_v, target_l)
-    return v, lw / ahead, feasible, binding, stale
+    worst, wall_x, wall_y = 0.0, 0.0, 0.0  # the wall the law's command presses on most
+    for k in range(first_wall, count):
+        shortfall = c[k] - (gx[k] * target_v + gy[k] * target_l)
+        if shortfall > worst:
+            worst, wall_x, wall_y = shortfall, normals[k, 0], normals[k, 1]
+    return v, lw / ahead, feasible, binding, stale, wall_x, wall_y
 
 
 @njit(cache=True)
@@ -232,9 +244,15 @@ def filter_command(
     ``poses`` (N, 3): every robot's last known pose, this one's current; ``ages`` (N,): how old each is
     (0 in lockstep); ``kinds``: TEAMMATE or PARKED; ``memory`` (2,): steps held so far and steps of the
     detour under way, updated in place (the engine and the agent both keep it, so lockstep agrees)."""
-    v, omega, feasible, binding, stale = safe_velocities(
+    v, omega, feasible, binding, stale, wall_x, wall_y = safe_velocities(
         v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
     )
+    if not binding and (wall_x != 0.0 or wall_y != 0.0) and _held(v_hat, omega_hat, v, omega, True, safety):
+        # Pressed on a wall (the law heads into it): slide along it instead (see _slide).
+        omega_hat = _slide(poses[me, 2], wall_x, wall_y, safety)
+        v, omega, feasible, binding, stale, _, _ = safe_velocities(
+            v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
+        )
     if stale:
         memory[0] = 0
         return 0.0, 0.0, STALE_NEIGHBOUR
@@ -248,7 +266,7 @@ def filter_command(
         else:
             memory[1] += 1
             flags |= KEEPING_RIGHT
-            v, omega, feasible, _, _ = safe_velocities(
+            v, omega, feasible, _, _, _, _ = safe_velocities(
                 v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, -KEEP_RIGHT
             )
     elif binding and _held(v_hat, omega_hat, v if feasible else 0.0, omega if feasible else 0.0, binding, safety):
@@ -264,6 +282,27 @@ def filter_command(
     if abs(v - v_hat) + safety.lookahead * abs(omega - omega_hat) > 1e-12 * (1.0 + abs(v_hat)):
         flags |= FILTER_CHANGED
     return v, omega, flags
+
+
+SLIDE_AWAY = math.radians(20.0)
+"""How far from the wall's tangent a robot sliding along it heads: at the barrier (h = 0) the filter lets a
+robot move only if it heads away from the wall by more than asin(κ) (9° at the paper's gains)."""
+
+
+@njit(cache=True)
+def _slide(theta: float, wall_x: float, wall_y: float, safety: SafetyParameters) -> float:
+    """An ω that slides a robot pressed on a wall along it (the wall-following rule of bug algorithms):
+    toward the wall's tangent nearest its heading, SLIDE_AWAY off the wall; head-on, to the right. The
+    centre barrier holds v alone, so a robot heading into a wall whose law does not turn it would stand
+    there for ever. From the heading, not the law's wish: that one may point back into the wall."""
+    gain = safety.omega_max / math.pi  # k_ω
+    along = math.cos(theta) * wall_x + math.sin(theta) * wall_y
+    tx, ty = math.cos(theta) - along * wall_x, math.sin(theta) - along * wall_y
+    if math.hypot(tx, ty) < 1e-6:
+        tx, ty = wall_y, -wall_x  # straight at it: to the right
+    side = math.atan2(ty, tx)
+    heading = side + SLIDE_AWAY * math.sin(wrap_angle(math.atan2(wall_y, wall_x) - side))
+    return gain * wrap_angle(heading - theta)
 
 
 @njit(cache=True)

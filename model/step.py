@@ -117,7 +117,7 @@ def decide_and_sense(
 @njit(cache=True)
 def _step_is_free(x: float, y: float, theta: float, v: float, omega: float, law: LawParameters, ground: Ground) -> bool:
     next_x, next_y, _ = unicycle_step(x, y, theta, v, omega, law.dt)
-    return disk_is_free(ground.occupied, next_x, next_y, ground.radius, law.cell, ground.bounded)
+    return disk_is_free(ground.occupied, next_x, next_y, ground.wall_clearance, law.cell, ground.bounded)
 
 
 def load_kernels(coverage: np.ndarray, pose: tuple[float, float, float], law: LawParameters, ground: Ground) -> None:

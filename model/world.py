@@ -65,6 +65,7 @@ class World:
             self.passable,
             scenario.robot_radius,
             plan_radius_of(scenario),
+            wall_clearance_of(scenario),
             bool(scenario.map),
             walls,
             occlusion,
@@ -116,8 +117,15 @@ class World:
 
 
 def plan_radius_of(scenario: Scenario) -> float:
-    """The robot's radius plus the planning margin: what passable cells and straight drives keep free."""
-    return scenario.robot_radius + PLANNING_MARGIN * scenario.cell
+    """The robot's radius plus the planning margin: what passable cells and straight drives keep free.
+    With the safety filter on, its margin too: the filter keeps the disk s off every wall (model.safety),
+    so a path nearer a wall than that would be one the filter stops the robot on."""
+    return wall_clearance_of(scenario) + PLANNING_MARGIN * scenario.cell
+
+
+def wall_clearance_of(scenario: Scenario) -> float:
+    """How near a wall the robot's centre comes: r, plus the safety margin when the filter is on."""
+    return scenario.robot_radius + (scenario.safety_margin if scenario.filters else 0.0)
 
 
 def team_space(passable: np.ndarray, cell: float) -> np.ndarray:

@@ -25,7 +25,7 @@ def test_the_pruned_wedge_hides_exactly_what_the_rule_hides(seed, theta, radius)
     occupied[int(y), int(x)] = False  # the robot never stands in an occupied cell
     positions = np.array([[x, y], *rng.uniform(0.0, 40.0, (3, 2))])
     coverage = np.zeros((40, 40), dtype=np.int64)
-    ground = Ground(occupied, ~occupied, radius, radius, False, True, True, 20)
+    ground = Ground(occupied, ~occupied, radius, radius, radius, False, True, True, 20)
     blind = ground._replace(occlusion=False)
     *_, row0, col0, seen = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, positions, 0)
     *_, row0b, col0b, everything = sense_wedge(
