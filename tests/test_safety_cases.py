@@ -1,0 +1,65 @@
+"""The three deadlock cases of issue 12 (scenarios/deadlocks/): each resolves, in process and over Zenoh.
+
+Corridor: two robots head-on, each sent to the other's start (exactly symmetric: the filter alone holds
+both, so a deadlock must be found). Corners: four robots swapping corners through the centre. Parked:
+a robot's objective lies behind a teammate parked on its own objective. Resolved means every robot
+gets within R/2 of its objective (where eq. 10 stops it) while no two ever come closer than 2r + s
+(less the arc's departure from its chord between steps).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from anicov.engine import run_scenario
+from model.scenario import PAPER_SCENARIO, load_scenario
+from runtime.rundir import summary_of
+from tests.teamrun import anicov, launcher_command, processes_of, run, unique_team
+
+CASES = PAPER_SCENARIO.parent / "deadlocks"
+ARC_SLACK = 0.01  # v·ω·dt²/8 at the paper's gains is 0.004
+
+
+def closest_approach(result, objectives: np.ndarray) -> np.ndarray:
+    """Per robot, the least distance from its centre to its objective over the run."""
+    return np.linalg.norm(result.trace[:, :, :2] - objectives[None], axis=2).min(axis=0)
+
+
+@pytest.mark.parametrize("case", ["corridor", "corners", "parked"])
+def test_each_deadlock_case_resolves_in_process(case):
+    scenario = load_scenario(CASES / f"{case}.toml")
+    result = run_scenario(scenario)
+    summary = summary_of(result)
+    reach = closest_approach(result, np.array(scenario.objectives))
+    assert (reach <= scenario.range / 2 + 0.05).all(), reach
+    assert summary["min_separation"] >= 2 * scenario.robot_radius + scenario.safety_margin - ARC_SLACK
+    assert summary["deadlocks"] >= 1 and summary["deadlocks_resolved"] == summary["deadlocks"]
+    if summary["min_clearance"] is not None:
+        assert summary["min_clearance"] >= scenario.robot_radius + scenario.safety_margin - 1e-9
+
+
+def test_without_the_filter_the_corridor_robots_drive_through_each_other():
+    """The same corridor with ``safety = false``: the disks overlap (what the filter is there to stop)."""
+    scenario = load_scenario(CASES / "corridor.toml").with_overrides(safety=False)
+    summary = summary_of(run_scenario(scenario))
+    assert summary["min_separation"] < 2 * scenario.robot_radius
+    assert summary["deadlocks"] == 0 and summary["filter_active_fraction"] == 0.0
+
+
+@pytest.mark.parametrize("case", ["corridor", "corners", "parked"])
+def test_each_deadlock_case_resolves_over_zenoh_as_in_process(tmp_path, case):
+    config = CASES / f"{case}.toml"
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+    assert engine.returncode == 1, engine.stderr  # max_time: these robots stop short of covering everything
+    team = unique_team()
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), team=team))
+    assert launched.returncode == 1, launched.stderr + launched.stdout
+    for name in ("trajectory.csv", "summary.json"):
+        assert (tmp_path / "engine" / name).read_bytes() == (tmp_path / "team" / name).read_bytes(), name
+    summary = json.loads((tmp_path / "team" / "summary.json").read_text())
+    assert summary["deadlocks"] >= 1 and summary["deadlocks_resolved"] == summary["deadlocks"]
+    assert "safety          filter on" in launched.stdout
+    assert processes_of(team) == []
