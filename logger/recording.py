@@ -16,6 +16,9 @@ units with y pointing up (x/cell, rows − y/cell):
     world/agents/<i>/wedge             LineStrips2D   the camera's footprint (eq. 2)
     world/agents/<i>/trail             LineStrips2D   the last TRAIL_STEPS of its path
     world/agents/<i>/objective         LineStrips2D   agent → its objective (Alg. 2)
+    world/agents/<i>/body              Ellipses2D     robots with a body: the disk of robot_radius, red
+                                                      while the safety filter changes its command
+    agents/<i>/safety_filter           Scalars        1 while the filter changes or stops the command, else 0
     metrics/e_D                        Scalars        eq. 5 (Fig. 4)
     agents/<i>/e_omega, v, omega       Scalars        eq. 6, 15, 16 (Fig. 5)
     run/scenario                       TextDocument   scenario, seed, team size (static)
@@ -37,6 +40,8 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from model.fixed_point import COVERAGE_SCALE
+from model.safety import DEADLOCK_FOUND, DEADLOCK_RESOLVED
+from model.safety_record import ACTIVE as FILTER_ACTIVE
 from model.scenario import Scenario
 from model.world import world_of
 
@@ -161,10 +166,24 @@ class RunRecorder:
         self.stream.log("run/events", rr.TextLog(text, level=level))
 
     def state(
-        self, agent: int, step: int, x: float, y: float, theta: float, v: float, omega: float, e_omega: float
+        self,
+        agent: int,
+        step: int,
+        x: float,
+        y: float,
+        theta: float,
+        v: float,
+        omega: float,
+        e_omega: float,
+        safety: int = 0,
     ) -> None:
-        """One agent's step; buffered and sent in columns (cheap), drawn fully on map steps."""
-        self._pending.setdefault(agent, []).append((step, x, y, theta, v, omega, e_omega))
+        """One agent's step (``safety``: the filter's flags, model.safety); buffered and sent in columns
+        (cheap), drawn fully on map steps. Deadlocks found and resolved go to the events."""
+        self._pending.setdefault(agent, []).append((step, x, y, theta, v, omega, e_omega, safety))
+        if safety & DEADLOCK_FOUND:
+            self.event(step, f"agent {agent}: held by a teammate, keeping right", "WARN")
+        if safety & DEADLOCK_RESOLVED:
+            self.event(step, f"agent {agent}: deadlock resolved")
         if step % self.map_every == 0:
             self._trails[agent].append((x, y))
             self._at(step)
@@ -200,11 +219,29 @@ class RunRecorder:
                 self.stream.send_columns(
                     f"agents/{agent}/{name}", indexes=indexes, columns=rr.Scalars.columns(scalars=data[:, column])
                 )
+            if self.scenario.robot_radius > 0.0:
+                self._send_bodies(agent, indexes, view, data[:, 7].astype(np.int64))
         self._pending = {}
         if self._pending_errors:
             data = np.array(self._pending_errors)
             self.domain_errors(data[:, 1], data[:, 0].astype(np.int64))
             self._pending_errors = []
+
+    def _send_bodies(self, agent: int, indexes: list, view: np.ndarray, flags: np.ndarray) -> None:
+        """The robot's disk at every step, red while the safety filter acts; and the filter as a series."""
+        active = (flags & FILTER_ACTIVE) != 0
+        half = self.scenario.robot_radius / self.scenario.cell
+        colors = np.where(active[:, None], np.array([[230, 40, 40, 255]]), np.array([[200, 200, 200, 255]]))
+        self.stream.send_columns(
+            f"world/agents/{agent}/body",
+            indexes=indexes,
+            columns=rr.Ellipses2D.columns(
+                centers=view, half_sizes=np.full((len(view), 2), half), colors=colors.astype(np.uint8)
+            ),
+        )
+        self.stream.send_columns(
+            f"agents/{agent}/safety_filter", indexes=indexes, columns=rr.Scalars.columns(scalars=active.astype(float))
+        )
 
     def domain_error(self, step: int, value: float) -> None:
         """e_D after ``step`` steps; buffered, sent with the states."""
@@ -261,9 +298,11 @@ def record_result(result, path: Path, recording_id: str, map_every: int = 50) ->
     """Write a finished in-process run (``anicov run``) as a recording."""
     recorder = RunRecorder(result.scenario, recording_id, path=path, map_every=map_every)
     trace = result.trace
+    flags = result.safety_flags
     for step in range(len(trace) - 1):
         for agent in range(result.scenario.agents):
-            recorder.state(agent, step, *trace[step, agent])
+            safety = int(flags[step, agent]) if flags is not None and step < len(flags) else 0
+            recorder.state(agent, step, *trace[step, agent], safety=safety)
     for plan in result.plans:
         step, members, targets, blobs, labels = plan
         recorder.objectives(step, trace[min(step, len(trace) - 1), :, :2], members, targets, blobs, labels)

@@ -101,7 +101,9 @@ class TeamLogger:
     def take_state(self, state: AgentState) -> None:
         """A state of step k; once the first of step k arrives (after its deltas), e_D and the map of k+1."""
         if state.step >= 0:
-            self.recorder.state(state.agent, state.step, *state.pose, state.v, state.omega, state.e_omega)
+            self.recorder.state(
+                state.agent, state.step, *state.pose, state.v, state.omega, state.e_omega, safety=state.safety
+            )
         self.positions[state.agent] = state.next_pose[:2]
         if state.step + 1 > self.latest_step:
             self.latest_step = state.step + 1

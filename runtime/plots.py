@@ -9,6 +9,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.patches import Circle
 
 from model.run import RunResult
 from model.scenario import Scenario
@@ -71,14 +72,11 @@ def plot_coverage_maps(result: RunResult, path: Path) -> None:
         upto = min(round(time / scenario.dt) + 1, len(result.trace))
         for agent in range(scenario.agents):
             (line,) = ax.plot(result.trace[:upto, agent, 0], result.trace[:upto, agent, 1], linewidth=0.6)
-            ax.plot(
-                result.trace[upto - 1, agent, 0],
-                result.trace[upto - 1, agent, 1],
-                "o",
-                markersize=5,
-                mfc="none",
-                color=line.get_color(),
-            )
+            x, y = result.trace[upto - 1, agent, 0], result.trace[upto - 1, agent, 1]
+            if scenario.robot_radius > 0.0:  # the robot's disk, to scale (issue 12)
+                ax.add_patch(Circle((x, y), scenario.robot_radius, fill=False, color=line.get_color(), linewidth=0.8))
+            else:
+                ax.plot(x, y, "o", markersize=5, mfc="none", color=line.get_color())
         ax.plot([0, width, width, 0, 0], [0, 0, height, height, 0], "k--", linewidth=0.8)
         ax.set_xlim(-0.1 * width, 1.1 * width)
         ax.set_ylim(-0.1 * height, 1.1 * height)

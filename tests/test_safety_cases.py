@@ -63,3 +63,24 @@ def test_each_deadlock_case_resolves_over_zenoh_as_in_process(tmp_path, case):
     assert summary["deadlocks"] >= 1 and summary["deadlocks_resolved"] == summary["deadlocks"]
     assert "safety          filter on" in launched.stdout
     assert processes_of(team) == []
+    # The recording draws every robot's disk and marks the steps its filter acted on.
+    marked = filter_marks(tmp_path / "team" / "recording.rrd")
+    assert set(marked) == set(range(summary["scenario"]["agents"]))
+    assert any(steps > 0 for steps in marked.values())
+
+
+def filter_marks(path) -> dict[int, int]:
+    """Per agent with a body drawn in the recording, the steps its ``safety_filter`` series is 1."""
+    from rerun.chunk import RrdReader
+
+    bodies, marked = set(), {}
+    for chunk in RrdReader(str(path)).stream():
+        entity = str(chunk.entity_path)
+        if entity.startswith("/world/agents/") and entity.endswith("/body"):
+            bodies.add(int(entity.split("/")[3]))
+        if entity.endswith("/safety_filter"):
+            values = chunk.to_record_batch().column("Scalars:scalars").to_pylist()
+            agent = int(entity.split("/")[2])
+            marked[agent] = marked.get(agent, 0) + sum(value[0] > 0 for value in values)
+    assert bodies == set(marked)
+    return marked
