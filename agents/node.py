@@ -15,7 +15,7 @@ from agents.robot import Robot, SimulatedUnicycle
 from model.coverage_map import load_kernels as load_map_kernels
 from model.ground import NO_FIELD
 from model.parameters import law_parameters, safety_parameters, starting_poses
-from model.safety import PARKED, TEAMMATE, filter_command
+from model.safety import PARKED, RAN_LATE, TEAMMATE, filter_command
 from model.safety import load_kernels as load_safety_kernels
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, load_kernels
@@ -203,8 +203,12 @@ class AgentNode:
 
     # ------------------------------------------------------------ control
 
-    def control_step(self) -> tuple[MapDelta, AgentState]:
-        """Decide, sense and move for the current step (eq. 1–16); return what to publish."""
+    def control_step(self, late: bool = False) -> tuple[MapDelta, AgentState]:
+        """Decide, sense and move for the current step (eq. 1–16); return what to publish.
+
+        ``late`` (realtime, with the safety filter): the loop fell a period or more behind its clock, so
+        this step is taken standing still. A robot catching up at full speed would move faster than
+        k_v in wall time, beyond what its teammates' margins allow for (a real base's watchdog stops it)."""
         assert self.objective is not None
         pose = self.robot.pose()
         me = self.options.agent
@@ -214,7 +218,9 @@ class AgentNode:
             self.replica.map.coverage, *pose, *self.objective, self.law, self.ground, field, self.positions, me
         )
         flags = 0
-        if self.safety.enabled:
+        if self.safety.enabled and late:
+            v, omega, flags = 0.0, 0.0, RAN_LATE
+        elif self.safety.enabled:
             self.poses[me] = pose
             v, omega, flags = filter_command(
                 v,

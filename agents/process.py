@@ -201,7 +201,8 @@ def run_realtime_steps(bus: Bus, period: float, stop: StopFlag, parent: int) -> 
             fill_gaps(bus.session, node.keys, node.replica, node.inbox)  # teammates' deltas lost on the way
             fetch(bus.session, node.keys.go_history, node.inbox, first=END_ONLY)  # the end of the run, if lost
             next_gap_check = time.monotonic() + GAP_CHECK_PERIOD
-        bus.publish(*node.control_step())
+        behind = time.monotonic() - (started + (node.step - first_step) * period)
+        bus.publish(*node.control_step(late=behind >= period))
         wait = started + (node.step - first_step) * period - time.monotonic()
         if wait > 0:
             stop.wait(wait)

@@ -16,10 +16,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from anicov.engine import advance_team, objective_fields
+from anicov.engine import advance_team, objective_fields, run_scenario
 from bench.machine import describe_machine
 from model.coverage_map import CoverageMap
-from model.parameters import coverage_map_of, initial_poses, law_parameters, starting_poses
+from model.parameters import coverage_map_of, initial_poses, law_parameters, safety_parameters, starting_poses
 from model.reachability import nearest_reachable
 from model.reference import numpy_team_step
 from model.run import TRACE_FIELDS
@@ -38,12 +38,14 @@ def engine_rate(agents: int, steps: int, scenario_path: Path = PAPER_SCENARIO, *
     fields = objective_fields(world, objectives)
     trace = np.zeros((steps, agents, len(TRACE_FIELDS)))
     errors = np.zeros(steps)
+    flags = np.zeros((steps, agents), dtype=np.uint8)
     total = coverage_map.target_ticks * coverage_map.counted_cells
+    safety, memory = safety_parameters(scenario), np.zeros((agents, 2), dtype=np.int64)
 
     def advance(coverage: np.ndarray, at: np.ndarray, count: int) -> int:
         done, _, _ = advance_team(
-            coverage, at, objectives, law, world.ground, fields, count,
-            coverage_map.uncovered_cells, coverage_map.deficit_ticks, total, trace, errors,
+            coverage, at, objectives, law, world.ground, fields, safety, memory, count,
+            coverage_map.uncovered_cells, coverage_map.deficit_ticks, total, trace, errors, flags,
         )  # fmt: skip
         return done
 
@@ -83,9 +85,39 @@ def main() -> None:
     warehouse = PAPER_SCENARIO.parent / "warehouse.toml"
     for agents in (4, 10):
         empty = engine_rate(agents, args.steps)
-        off = engine_rate(agents, args.steps, warehouse, occlusion=False)
-        on = engine_rate(agents, args.steps, warehouse)
+        off = engine_rate(agents, args.steps, warehouse, occlusion=False, safety=False)
+        on = engine_rate(agents, args.steps, warehouse, safety=False)
         print(f"| {agents} | {empty:,.0f} | {off:,.0f} | {on:,.0f} | {empty / on:.2f}× the cost |")
+
+    print()
+    safety_table(args.steps)
+
+
+def run_rate(agents: int, seeds: int, **overrides: object) -> float:
+    """Agent-steps/s of whole runs (planner and filter included) on the paper's domain, seeds 0.."""
+    agent_steps, elapsed = 0, 0.0
+    for seed in range(seeds):
+        scenario = load_scenario(PAPER_SCENARIO).with_overrides(agents=agents, seed=seed, **overrides)
+        poses = starting_poses(scenario.with_overrides(safety=True))  # the same start, filter on or off
+        started = time.perf_counter()
+        result = run_scenario(scenario, poses=poses, record_trace=False)
+        elapsed += time.perf_counter() - started
+        agent_steps += result.steps * agents
+    return agent_steps / elapsed
+
+
+def safety_table(steps: int) -> None:
+    """Issue 12: the filter's cost, robots of radius 0.5 with s = 0.2, on the paper's domain."""
+    print("| team N | filter off agent-steps/s | filter on agent-steps/s | cost | what runs |")
+    print("|---|---|---|---|---|")
+    body = {"robot_radius": 0.5, "safety_margin": 0.2}
+    for agents in (4, 30):
+        run_scenario(load_scenario(PAPER_SCENARIO).with_overrides(agents=agents, max_time=1.0, **body))  # compile
+        off, on = run_rate(agents, 3, safety=False, **body), run_rate(agents, 3, **body)
+        print(f"| {agents} | {off:,.0f} | {on:,.0f} | {off / on:.2f}× | whole runs, seeds 0-2 |")
+        off = engine_rate(agents, steps, safety=False, **body)
+        on = engine_rate(agents, steps, **body)
+        print(f"| {agents} | {off:,.0f} | {on:,.0f} | {off / on:.2f}× | kernel, all sent to one point (a crowd) |")
 
 
 if __name__ == "__main__":

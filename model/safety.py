@@ -46,6 +46,7 @@ NO_SAFE_COMMAND = 4  # the QP was empty: stopped
 STALE_NEIGHBOUR = 8  # a teammate in range sent no pose for max_pose_age: stopped
 DEADLOCK_FOUND = 16  # held by a teammate for STUCK_STEPS: the detour starts
 DEADLOCK_RESOLVED = 32  # the law's command passes again after a detour
+RAN_LATE = 64  # realtime: the control loop fell behind its clock; the robot held still for this step
 
 STUCK_STEPS = 10
 """Steps a robot may be held by a teammate (moving at under HELD_FRACTION of the law's speed) before
@@ -247,8 +248,9 @@ def filter_command(
     v, omega, feasible, binding, stale, wall_x, wall_y = safe_velocities(
         v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
     )
-    if not binding and (wall_x != 0.0 or wall_y != 0.0) and _held(v_hat, omega_hat, v, omega, True, safety):
-        # Pressed on a wall (the law heads into it): slide along it instead (see _slide).
+    pressed = wall_x != 0.0 or wall_y != 0.0
+    if not binding and pressed and abs(v_hat) > 0.01 * safety.v_max and abs(v) < HELD_FRACTION * abs(v_hat):
+        # Pressed on a wall (the law drives into it and the wall stops it): slide along it (see _slide).
         omega_hat = _slide(poses[me, 2], wall_x, wall_y, safety)
         v, omega, feasible, binding, stale, _, _ = safe_velocities(
             v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
@@ -299,7 +301,7 @@ def _slide(theta: float, wall_x: float, wall_y: float, safety: SafetyParameters)
     along = math.cos(theta) * wall_x + math.sin(theta) * wall_y
     tx, ty = math.cos(theta) - along * wall_x, math.sin(theta) - along * wall_y
     if math.hypot(tx, ty) < 1e-6:
-        tx, ty = wall_y, -wall_x  # straight at it: to the right
+        tx, ty = -wall_y, wall_x  # straight at it: to the right (n points back at the robot)
     side = math.atan2(ty, tx)
     heading = side + SLIDE_AWAY * math.sin(wrap_angle(math.atan2(wall_y, wall_x) - side))
     return gain * wrap_angle(heading - theta)

@@ -3,12 +3,16 @@ reports whenever robots have a body, with the filter on or off (so the two can b
 
 - ``min_separation``: the least distance between two robots' centres, over every step and along the
   straight line between consecutive poses (the closest approach of two linear motions; a unicycle's arc
-  departs from its chord by at most v·ω·dt²/8, 0.004 units at the paper's gains). Safe: ≥ 2r.
+  departs from its chord by at most v·ω·dt²/8, 0.004 units at the paper's gains). Safe: ≥ 2r. Realtime,
+  robots' steps of the same index are taken as simultaneous (each steps on its own clock from the same
+  start), and steps whose state never reached the coordinator are interpolated.
 - ``min_clearance``: the least distance from a centre to an occupied cell (or, on a map, its edge), at
   every pose of the trace. Safe: ≥ r. None in the open world.
 - ``filter_active_fraction``: the share of agent-steps whose command the filter changed or stopped.
 - ``deadlocks`` / ``deadlocks_resolved``: robots held still by a teammate long enough to start a detour,
   and the detours that ended with the law's own command passing again (model.safety).
+- ``late_steps``: realtime, agent-steps taken standing still because the control loop fell a period
+  behind its clock (0 in lockstep and in the engine).
 """
 
 from __future__ import annotations
@@ -26,18 +30,36 @@ from model.safety import (
     FILTER_CHANGED,
     KEEPING_RIGHT,
     NO_SAFE_COMMAND,
+    RAN_LATE,
     STALE_NEIGHBOUR,
 )
 
 ACTIVE = FILTER_CHANGED | KEEPING_RIGHT | NO_SAFE_COMMAND | STALE_NEIGHBOUR
 
 
+def fill_unheard(positions: np.ndarray) -> np.ndarray:
+    """A realtime trace's positions with the steps never heard (NaN) filled by straight-line interpolation
+    between the heard ones of the same robot (before the first and after the last: left NaN)."""
+    if np.isfinite(positions).all():
+        return positions
+    filled = positions.copy()
+    steps = np.arange(len(positions))
+    for agent in range(positions.shape[1]):
+        heard = np.isfinite(positions[:, agent, 0])
+        if heard.sum() >= 2:
+            inside = (steps >= steps[heard][0]) & (steps <= steps[heard][-1])
+            for axis in (0, 1):
+                filled[inside, agent, axis] = np.interp(steps[inside], steps[heard], positions[heard, agent, axis])
+    return filled
+
+
 def min_separation(positions: np.ndarray) -> float | None:
-    """Least centre distance over the (steps, N, 2) positions and the segments between them (NaN rows,
-    steps a realtime trace never heard, are skipped). None with fewer than two robots."""
+    """Least centre distance over the (steps, N, 2) positions and the segments between them (a realtime
+    trace's unheard steps interpolated, :func:`fill_unheard`). None with fewer than two robots."""
     agents = positions.shape[1]
     if agents < 2 or len(positions) == 0:
         return None
+    positions = fill_unheard(positions)
     first, second = np.triu_indices(agents, 1)
     relative = positions[:, first] - positions[:, second]  # (steps, pairs, 2)
     least = np.nanmin(np.linalg.norm(relative, axis=2)) if np.isfinite(relative).any() else math.inf
@@ -85,4 +107,5 @@ def safety_figures(positions: np.ndarray, flags: np.ndarray | None, ground: Grou
         "filter_active_fraction": float(((flags & ACTIVE) != 0)[heard].sum() / steps) if steps else 0.0,
         "deadlocks": int(((flags & DEADLOCK_FOUND) != 0).sum()),
         "deadlocks_resolved": int(((flags & DEADLOCK_RESOLVED) != 0).sum()),
+        "late_steps": int(((flags & RAN_LATE) != 0).sum()),
     }
