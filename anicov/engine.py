@@ -126,22 +126,10 @@ def run_scenario(
             plans.append(planner.record(steps_done, objectives))
         steps = min(block, scenario.max_steps - steps_done)
         done, coverage_map.uncovered_cells, coverage_map.deficit_ticks = advance_team(
-            coverage_map.coverage,
-            poses,
-            objectives,
-            law,
-            world.ground,
-            objective_fields(world, objectives),
-            safety,
-            memory,
-            steps,
-            coverage_map.uncovered_cells,
-            coverage_map.deficit_ticks,
-            coverage_map.target_ticks * coverage_map.counted_cells,
-            scratch_trace,
-            scratch_errors,
-            scratch_flags,
-        )
+            coverage_map.coverage, poses, objectives, law, world.ground, objective_fields(world, objectives),
+            safety, memory, steps, coverage_map.uncovered_cells, coverage_map.deficit_ticks,
+            coverage_map.target_ticks * coverage_map.counted_cells, scratch_trace, scratch_errors, scratch_flags,
+        )  # fmt: skip
         flags.append(scratch_flags[:done].copy())
         if record_trace:
             traces.append(scratch_trace[:done].copy())

@@ -123,21 +123,21 @@ def _row(name: str, agents: int, on: list[dict[str, Any]], off: list[dict[str, A
 def format_table(report: dict[str, Any]) -> str:
     """safety.md: one line per domain and team size."""
     lines = [
-        f"# Safety: the filter on and off, r = {report['radius']}, s = {report['margin']} ({report['runs']} seeded runs each)",
+        f"# Safety: the filter on and off, r = {report['radius']}, s = {report['margin']}",
         "",
         "Same seeds and starting poses for both. Collisions: runs in which two centres ever came closer than",
         "2r (at a step or on the chord between steps); in walls: runs in which a centre came closer than r to",
         "a wall. Mean t_N and team path over the seeds both settings completed. Cost: mean t_N with the",
         f"filter over without, less 1; goal at N = 10: at most {100 * report['goal']:.0f} %.",
         "",
-        "| domain | N | completed on / off | collisions on / off | in walls on / off | min separation on / off | "
+        "| domain | N | runs | completed on / off | collisions on / off | in walls on / off | min separation on / off | "
         "mean t_N on / off | cost | mean team path on / off | filter active | deadlocks resolved |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for row in report["rows"]:
         on, off = row["on"], row["off"]
         lines.append(
-            f"| {row['domain']} | {row['agents']} | {on['completed']} / {off['completed']} | "
+            f"| {row['domain']} | {row['agents']} | {row['runs']} | {on['completed']} / {off['completed']} | "
             f"{on['collisions']} / {off['collisions']} | {on['in_walls']} / {off['in_walls']} | "
             f"{_fmt(on['min_separation'], 3)} / {_fmt(off['min_separation'], 3)} | "
             f"{_fmt(on['mean_time'], 1)} / {_fmt(off['mean_time'], 1)} | {_percent(row['time_cost'])} | "
@@ -145,6 +145,14 @@ def format_table(report: dict[str, Any]) -> str:
             f"{100 * on['filter_active_fraction']:.1f} % | {on['deadlocks_resolved']}/{on['deadlocks']} |"
         )
     return "\n".join(lines) + "\n"
+
+
+def merge_reports(*reports: dict[str, Any]) -> dict[str, Any]:
+    """One report of several studies' rows (e.g. the paper's domain and the maps run apart)."""
+    merged = dict(reports[0])
+    merged["rows"] = [row for report in reports for row in report["rows"]]
+    merged["runs"] = max(report["runs"] for report in reports)
+    return merged
 
 
 def _fmt(value: float | None, digits: int) -> str:

@@ -194,7 +194,11 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
             if key in _POSITIVE_FLOATS and number <= 0.0:
                 raise ScenarioError(f"scenario key '{key}': expected a positive number, got {value!r}")
             resolved[key] = number
-    scenario = replace(Scenario(), **resolved)
+    return _check_whole(replace(Scenario(), **resolved))
+
+
+def _check_whole(scenario: Scenario) -> Scenario:
+    """The checks that read several keys at once."""
     if scenario.controller == "zigzag" and scenario.has_terrain:
         raise ScenarioError(
             "scenario key 'controller': 'zigzag' flies the open domain's lanes and knows no walls or robot "
