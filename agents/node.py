@@ -237,7 +237,8 @@ class AgentNode:
         delta = MapDelta(self.options.agent, self.step, row0, col0, ticks)
         self.replica.apply(delta)
         next_pose = self.robot.command(v, omega)
-        state = AgentState(self.options.agent, self.step, pose, v, omega, e_omega, next_pose, flags)
+        stamp = time.time() if self.options.clock == "realtime" else 0.0  # a team clock for the safety record
+        state = AgentState(self.options.agent, self.step, pose, v, omega, e_omega, next_pose, flags, stamp)
         self.step += 1
         return delta, state
 

@@ -26,6 +26,9 @@ class RunLog:
     events: list[str] = field(default_factory=list)
     last_step: dict[int, int] = field(default_factory=dict)
     safety: dict[int, np.ndarray] = field(default_factory=dict)  # step → (N,) safety filter flags
+    timed: dict[int, dict[int, tuple[float, float, float]]] = field(
+        default_factory=dict
+    )  # agent → step → (stamp, x, y)
 
     def record(self, state: AgentState) -> None:
         """Keep a state's trace row and, if it is the agent's latest, its pose at the end of the step."""
@@ -36,6 +39,8 @@ class RunLog:
             row[state.agent] = (*state.pose, state.v, state.omega, state.e_omega)
             if state.safety:
                 self.safety.setdefault(state.step, np.zeros(self.agents, dtype=np.uint8))[state.agent] = state.safety
+            if state.stamp:
+                self.timed.setdefault(state.agent, {})[state.step] = (state.stamp, *state.next_pose[:2])
         if state.step >= self.last_step.get(state.agent, -2):
             self.final_poses[state.agent] = state.next_pose
             self.last_step[state.agent] = state.step
@@ -70,4 +75,8 @@ class RunLog:
             snapshots=self.snapshots,
             final_lack=final_lack,
             safety_flags=flags,
+            timed_positions={
+                agent: np.array([rows[step] for step in sorted(rows)]) for agent, rows in self.timed.items()
+            }
+            or None,
         )

@@ -4,8 +4,9 @@ reports whenever robots have a body, with the filter on or off (so the two can b
 - ``min_separation``: the least distance between two robots' centres, over every step and along the
   straight line between consecutive poses (the closest approach of two linear motions; a unicycle's arc
   departs from its chord by at most v·ω·dt²/8, 0.004 units at the paper's gains). Safe: ≥ 2r. Realtime,
-  robots' steps of the same index are taken as simultaneous (each steps on its own clock from the same
-  start), and steps whose state never reached the coordinator are interpolated.
+  on the wall clock instead: each state carries the time its robot reached its pose (one host's clock,
+  or clocks kept in sync), the positions of each robot are joined by straight lines in time and every
+  pair is compared at the union of their times (states that never reached the coordinator are bridged).
 - ``min_clearance``: the least distance from a centre to an occupied cell (or, on a map, its edge), at
   every pose of the trace. Safe: ≥ r. None in the open world.
 - ``filter_active_fraction``: the share of agent-steps whose command the filter changed or stopped.
@@ -75,6 +76,38 @@ def min_separation(positions: np.ndarray) -> float | None:
     return float(least) if math.isfinite(least) else None
 
 
+def _closest_on_segments(relative: np.ndarray) -> float:
+    """Least |r| over the (M, 2) relative positions and the straight segments between consecutive ones."""
+    least = float(np.linalg.norm(relative, axis=1).min())
+    start, motion = relative[:-1], relative[1:] - relative[:-1]
+    length2 = np.einsum("mk,mk->m", motion, motion)
+    moving = length2 > 0.0
+    if moving.any():
+        t = np.clip(-np.einsum("mk,mk->m", start[moving], motion[moving]) / length2[moving], 0.0, 1.0)
+        least = min(least, float(np.linalg.norm(start[moving] + t[:, None] * motion[moving], axis=1).min()))
+    return least
+
+
+def min_separation_in_time(timed: dict[int, np.ndarray]) -> float | None:
+    """Realtime: the least centre distance with every robot's positions on one wall clock, each
+    robot's (time, x, y) after its steps joined by straight lines, over the times both of a pair were
+    heard. None with fewer than two robots heard."""
+    least = math.inf
+    agents = sorted(agent for agent, rows in timed.items() if len(rows) >= 2)
+    for index, first in enumerate(agents):
+        a = timed[first][np.argsort(timed[first][:, 0], kind="stable")]
+        for second in agents[index + 1 :]:
+            b = timed[second][np.argsort(timed[second][:, 0], kind="stable")]
+            times = np.union1d(a[:, 0], b[:, 0])
+            times = times[(times >= max(a[0, 0], b[0, 0])) & (times <= min(a[-1, 0], b[-1, 0]))]
+            if len(times) == 0:
+                continue
+            dx = np.interp(times, a[:, 0], a[:, 1]) - np.interp(times, b[:, 0], b[:, 1])
+            dy = np.interp(times, a[:, 0], a[:, 2]) - np.interp(times, b[:, 0], b[:, 2])
+            least = min(least, _closest_on_segments(np.stack([dx, dy], axis=1)))
+    return least if math.isfinite(least) else None
+
+
 @njit(cache=True)
 def _least_clearance(
     occupied: np.ndarray, xs: np.ndarray, ys: np.ndarray, cap: float, cell: float, bounded: bool
@@ -96,13 +129,20 @@ def min_clearance(positions: np.ndarray, ground: Ground, cell: float) -> float |
     return float(_least_clearance(ground.occupied, xs, ys, cap, cell, ground.bounded))
 
 
-def safety_figures(positions: np.ndarray, flags: np.ndarray | None, ground: Ground, cell: float) -> dict[str, object]:
-    """The summary.json safety figures of a run (see the module docstring)."""
+def safety_figures(
+    positions: np.ndarray,
+    flags: np.ndarray | None,
+    ground: Ground,
+    cell: float,
+    timed: dict[int, np.ndarray] | None = None,
+) -> dict[str, object]:
+    """The summary.json safety figures of a run (see the module docstring); ``timed``: a realtime run's
+    stamped positions, from which min_separation is taken on the wall clock."""
     flags = np.zeros((0, positions.shape[1]), dtype=np.uint8) if flags is None else flags
     heard = np.isfinite(positions[: len(flags), :, 0]) if len(flags) else np.zeros(flags.shape, dtype=bool)
     steps = int(heard.sum())
     return {
-        "min_separation": min_separation(positions),
+        "min_separation": min_separation(positions) if timed is None else min_separation_in_time(timed),
         "min_clearance": min_clearance(positions, ground, cell),
         "filter_active_fraction": float(((flags & ACTIVE) != 0)[heard].sum() / steps) if steps else 0.0,
         "deadlocks": int(((flags & DEADLOCK_FOUND) != 0).sum()),

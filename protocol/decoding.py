@@ -132,6 +132,7 @@ def _decode_state(body: dict[str, Any], limits: Limits) -> AgentState:
         e_omega,
         (nxt[0], nxt[1], nxt[2]),
         _int(body, "safety", 0, 255) if "safety" in body else 0,
+        _finite(body["stamp"], "stamp") if "stamp" in body else 0.0,
     )
 
 

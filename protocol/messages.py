@@ -76,6 +76,7 @@ class AgentState:
     e_omega: float
     next_pose: Pose
     safety: int = 0  # what the safety filter did this step (model.safety flag bits; 0: nothing)
+    stamp: float = 0.0  # realtime: the wall-clock time (time.time(), s) it reached next_pose; 0 in lockstep
 
 
 @dataclass(frozen=True)
@@ -168,14 +169,18 @@ def _delta_body(message: MapDelta) -> dict[str, Any]:
 
 
 def _state_body(message: AgentState) -> dict[str, Any]:
-    return {
-        "agent": message.agent,
-        "step": message.step,
-        "pose": list(message.pose),
-        "vel": [message.v, message.omega],
-        "e_omega": message.e_omega,
-        "next": list(message.next_pose),
-    } | ({"safety": message.safety} if message.safety else {})
+    return (
+        {
+            "agent": message.agent,
+            "step": message.step,
+            "pose": list(message.pose),
+            "vel": [message.v, message.omega],
+            "e_omega": message.e_omega,
+            "next": list(message.next_pose),
+        }
+        | ({"safety": message.safety} if message.safety else {})
+        | ({"stamp": message.stamp} if message.stamp else {})
+    )
 
 
 def _objectives_body(message: Objectives) -> dict[str, Any]:

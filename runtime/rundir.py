@@ -61,7 +61,9 @@ def summary_of(result: RunResult) -> dict[str, Any]:
     if not world.open or scenario.priority_map:
         summary["terrain"] = world.summary()
     if scenario.robot_radius > 0.0 and len(result.trace) == result.steps + 1:  # filter on or off, to compare
-        summary |= safety_figures(result.trace[:, :, :2], result.safety_flags, world.ground, scenario.cell)
+        summary |= safety_figures(
+            result.trace[:, :, :2], result.safety_flags, world.ground, scenario.cell, result.timed_positions
+        )
     return summary
 
 

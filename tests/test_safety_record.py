@@ -46,3 +46,14 @@ def test_figures_count_the_flags():
     assert figures["filter_active_fraction"] == 2 / 6
     assert (figures["deadlocks"], figures["deadlocks_resolved"], figures["late_steps"]) == (1, 1, 1)
     assert figures["min_separation"] == 5.0 and figures["min_clearance"] is None
+
+
+def test_realtime_separation_is_taken_on_the_wall_clock():
+    from model.safety_record import min_separation_in_time
+
+    # Robot 0 moves along y = 0 from x = 0 to 10 over t 0..10; robot 1 stands at (5, 1) but was heard at
+    # other instants: on the wall clock they pass 1 apart at t = 5.
+    first = np.array([[0.0, 0.0, 0.0], [10.0, 10.0, 0.0]])
+    second = np.array([[0.5, 5.0, 1.0], [3.7, 5.0, 1.0], [9.5, 5.0, 1.0]])
+    assert math.isclose(min_separation_in_time({0: first, 1: second}), 1.0)
+    assert min_separation_in_time({0: first}) is None
