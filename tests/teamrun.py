@@ -93,6 +93,9 @@ def interrupt(process: subprocess.Popen, number: int = signal.SIGINT) -> None:
 def write_scenario(path: Path, **values: object) -> Path:
     lines = []
     for key, value in values.items():
+        if isinstance(value, bool):
+            lines.append(f"{key} = {str(value).lower()}")
+            continue
         lines.append(f"{key} = {value!r}".replace("'", '"') if not isinstance(value, list) else f"{key} = {value}")
     path.write_text("\n".join(lines) + "\n")
     return path

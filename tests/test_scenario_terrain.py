@@ -75,7 +75,8 @@ def test_a_map_with_no_free_cell_and_a_team_too_big_fail_before_any_process_star
     room = np.ones((10, 10), dtype=bool)
     room[4:6, 4:6] = False  # room for one robot of radius 0.4, not for three
     write_map(tmp_path, "cell", room)
-    config = write_scenario(tmp_path / "b.toml", map="cell.yaml", robot_radius=0.4, agents=3)
+    # The terrain rule alone (issue 11): the safety filter's margin would leave no room at all.
+    config = write_scenario(tmp_path / "b.toml", map="cell.yaml", robot_radius=0.4, agents=3, safety=False)
     done = anicov("run", "--config", str(config), "--out", str(tmp_path / "b"))
     assert done.returncode == 2 and "cell.yaml" in done.stderr and "cannot hold 3 robots" in done.stderr
     assert not (tmp_path / "b").exists()

@@ -54,8 +54,13 @@ def test_a_pocket_narrower_than_the_robot_is_outside_the_team_space():
     occupied = np.zeros((20, 20), dtype=bool)
     occupied[10, :] = True
     occupied[10, 5] = False  # a one-cell gap: a robot of radius 0.6 does not pass
-    scenario_free = world_of(validate({"domain": [20.0, 20.0], "robot_radius": 0.4, "obstacles": _walls(occupied)}))
-    scenario_wide = world_of(validate({"domain": [20.0, 20.0], "robot_radius": 0.6, "obstacles": _walls(occupied)}))
+    # Issue 11's rule alone: with the safety filter on, its margin s would also count (model.world.plan_radius_of).
+    scenario_free = world_of(
+        validate({"domain": [20.0, 20.0], "robot_radius": 0.4, "safety": False, "obstacles": _walls(occupied)})
+    )
+    scenario_wide = world_of(
+        validate({"domain": [20.0, 20.0], "robot_radius": 0.6, "safety": False, "obstacles": _walls(occupied)})
+    )
     assert scenario_free.reachable[15, 5] and scenario_free.reachable[5, 5]
     assert scenario_wide.reachable[:10].any() != scenario_wide.reachable[11:].any()
 
