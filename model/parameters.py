@@ -13,6 +13,7 @@ from model.clearance import disk_is_free
 from model.coverage_map import CoverageMap
 from model.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
+from model.scenario_safety import point_speed
 from model.step import LawParameters
 from model.world import world_of
 
@@ -156,7 +157,7 @@ def safety_parameters(scenario: Scenario) -> SafetyParameters:
     if not scenario.filters:
         return disabled_safety()
     omega_max = math.pi * scenario.k_omega
-    point_speed = math.hypot(scenario.k_v, scenario.lookahead * omega_max)
+    fastest = point_speed(scenario.k_v, scenario.k_omega, scenario.lookahead)
     return SafetyParameters(
         enabled=True,
         radius=scenario.robot_radius,
@@ -167,7 +168,7 @@ def safety_parameters(scenario: Scenario) -> SafetyParameters:
         v_max=scenario.k_v,
         omega_max=omega_max,
         dt=scenario.dt,
-        point_speed=point_speed,
-        slack=point_speed * omega_max * scenario.dt**2 / 2.0,
+        point_speed=fastest,
+        slack=fastest * omega_max * scenario.dt**2 / 2.0,
         max_pose_age=scenario.max_pose_age,
     )

@@ -193,7 +193,7 @@ def safe_velocities(
     cell: float,
     safety: SafetyParameters,
     turn: float,
-) -> tuple[float, float, bool, bool, bool]:
+) -> tuple[float, float, bool, bool, bool, float, float]:
     """The QP for robot ``me`` at ``poses[me]``: the safe (v, ω) nearest the law's (v̂, ω̂), whose
     velocity is first turned by ``turn`` (a detour). Returns (v, ω, feasible, a teammate binds the law's
     command, a live teammate in reach is older than max_pose_age, the normal of the wall it presses on
@@ -248,16 +248,16 @@ def filter_command(
     v, omega, feasible, binding, stale, wall_x, wall_y = safe_velocities(
         v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
     )
+    if stale:  # it depends on the poses alone, not on the command
+        memory[0] = 0
+        return 0.0, 0.0, STALE_NEIGHBOUR
     pressed = wall_x != 0.0 or wall_y != 0.0
     if not binding and pressed and abs(v_hat) > 0.01 * safety.v_max and abs(v) < HELD_FRACTION * abs(v_hat):
         # Pressed on a wall (the law drives into it and the wall stops it): slide along it (see _slide).
         omega_hat = _slide(poses[me, 2], wall_x, wall_y, safety)
-        v, omega, feasible, binding, stale, _, _ = safe_velocities(
+        v, omega, feasible, binding, _, _, _ = safe_velocities(
             v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
         )
-    if stale:
-        memory[0] = 0
-        return 0.0, 0.0, STALE_NEIGHBOUR
     flags = 0
     if memory[1] > 0:  # on a detour: back on the law's command once it passes the filter
         if feasible and not _held(v_hat, omega_hat, v, omega, binding, safety):

@@ -62,29 +62,24 @@ def min_separation(positions: np.ndarray) -> float | None:
         return None
     positions = fill_unheard(positions)
     first, second = np.triu_indices(agents, 1)
-    relative = positions[:, first] - positions[:, second]  # (steps, pairs, 2)
-    least = np.nanmin(np.linalg.norm(relative, axis=2)) if np.isfinite(relative).any() else math.inf
-    if len(positions) > 1:
+    least = _closest_approach(positions[:, first] - positions[:, second])  # (steps, pairs, 2)
+    return least if math.isfinite(least) else None
+
+
+def _closest_approach(relative: np.ndarray) -> float:
+    """Least |r| over relative positions (M, ..., 2) in time order and the straight segments between
+    consecutive ones (the closest approach of two linear motions); NaN entries are skipped."""
+    distances = np.linalg.norm(relative, axis=-1)
+    least = float(np.nanmin(distances)) if np.isfinite(distances).any() else math.inf
+    if len(relative) > 1:
         start, motion = relative[:-1], relative[1:] - relative[:-1]
-        length2 = np.einsum("spk,spk->sp", motion, motion)
+        length2 = np.sum(motion * motion, axis=-1)
         with np.errstate(invalid="ignore", divide="ignore"):
-            t = np.clip(-np.einsum("spk,spk->sp", start, motion) / length2, 0.0, 1.0)
+            t = np.clip(-np.sum(start * motion, axis=-1) / length2, 0.0, 1.0)
         t = np.where(length2 > 0.0, t, 0.0)
-        closest = np.linalg.norm(start + t[..., None] * motion, axis=2)
+        closest = np.linalg.norm(start + t[..., None] * motion, axis=-1)
         if np.isfinite(closest).any():
             least = min(least, float(np.nanmin(closest)))
-    return float(least) if math.isfinite(least) else None
-
-
-def _closest_on_segments(relative: np.ndarray) -> float:
-    """Least |r| over the (M, 2) relative positions and the straight segments between consecutive ones."""
-    least = float(np.linalg.norm(relative, axis=1).min())
-    start, motion = relative[:-1], relative[1:] - relative[:-1]
-    length2 = np.einsum("mk,mk->m", motion, motion)
-    moving = length2 > 0.0
-    if moving.any():
-        t = np.clip(-np.einsum("mk,mk->m", start[moving], motion[moving]) / length2[moving], 0.0, 1.0)
-        least = min(least, float(np.linalg.norm(start[moving] + t[:, None] * motion[moving], axis=1).min()))
     return least
 
 
@@ -104,7 +99,7 @@ def min_separation_in_time(timed: dict[int, np.ndarray]) -> float | None:
                 continue
             dx = np.interp(times, a[:, 0], a[:, 1]) - np.interp(times, b[:, 0], b[:, 1])
             dy = np.interp(times, a[:, 0], a[:, 2]) - np.interp(times, b[:, 0], b[:, 2])
-            least = min(least, _closest_on_segments(np.stack([dx, dy], axis=1)))
+            least = min(least, _closest_approach(np.stack([dx, dy], axis=1)))
     return least if math.isfinite(least) else None
 
 

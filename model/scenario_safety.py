@@ -72,6 +72,11 @@ def resolve_safety_key(key: str, value: Any) -> Any:
     return _number(key, value, positive=key != "safety_margin")
 
 
+def point_speed(k_v: float, k_omega: float, lookahead: float) -> float:
+    """u_max = √(k_v² + (l·π·k_ω)²): the fastest a look-ahead point moves within the paper's bounds."""
+    return math.hypot(k_v, lookahead * math.pi * k_omega)
+
+
 def least_safety_range(
     radius: float, margin: float, lookahead: float, point_speed: float, dt: float, age: float
 ) -> float:
