@@ -251,6 +251,7 @@ def filter_command(
     if stale:  # it depends on the poses alone, not on the command
         memory[0] = 0
         return 0.0, 0.0, STALE_NEIGHBOUR
+    law_omega = omega_hat  # what FILTER_CHANGED compares with, also when the slide turns the nominal
     pressed = wall_x != 0.0 or wall_y != 0.0
     if not binding and pressed and abs(v_hat) > 0.01 * safety.v_max and abs(v) < HELD_FRACTION * abs(v_hat):
         # Pressed on a wall (the law drives into it and the wall stops it): slide along it (see _slide).
@@ -281,7 +282,7 @@ def filter_command(
         memory[0] = 0
     if not feasible:
         return 0.0, 0.0, flags | NO_SAFE_COMMAND
-    if abs(v - v_hat) + safety.lookahead * abs(omega - omega_hat) > 1e-12 * (1.0 + abs(v_hat)):
+    if abs(v - v_hat) + safety.lookahead * abs(omega - law_omega) > 1e-12 * (1.0 + abs(v_hat)):
         flags |= FILTER_CHANGED
     return v, omega, flags
 
