@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import argparse
 
-from model.scenario import ScenarioError
+from agents.ros2.arguments import RobotArgumentError, add_robot_arguments
+from model.scenario import Scenario, ScenarioError
 from runtime.arguments import add_process_arguments, scenario_from_arguments
 
 
@@ -16,6 +17,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--id", type=int, required=True, help="this agent's id, 0..N-1")
     parser.add_argument("--counts", help="write message counters to this JSON file at exit")
     add_process_arguments(parser)
+    add_robot_arguments(parser)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -30,4 +32,22 @@ def main(args: argparse.Namespace) -> int:
     if not 0 <= args.id < scenario.agents:
         raise ScenarioError(f"--id: expected an agent id from 0 to {scenario.agents - 1}, got {args.id}")
     options = AgentOptions(args.team, args.id, args.clock, args.speed, args.drop_rate, args.counts)
-    return run_agent(scenario, options, config_from_arguments(args), stop)
+    ros2 = ros2_options(args, scenario) if args.robot == "ros2" else None
+    return run_agent(scenario, options, config_from_arguments(args), stop, ros2)
+
+
+def ros2_options(args: argparse.Namespace, scenario: Scenario):
+    """The ROS 2 driver's options, once the extra is installed and the clock is the robot's own."""
+    from agents.ros2 import require_rosbags
+    from agents.ros2.arguments import ros2_options_from
+
+    require_rosbags()
+    if args.clock != "realtime":
+        raise RobotArgumentError("--robot ros2 drives a real base, which cannot wait for a lockstep go: use --clock realtime")
+    real_time = 1.0 / scenario.seconds_per_unit
+    if abs(args.speed - real_time) > 1e-9 * real_time:
+        raise RobotArgumentError(
+            f"--speed: a real base moves in real time: expected --speed {real_time:g} (1 / the scenario's "
+            f"seconds_per_unit {scenario.seconds_per_unit:g}), got {args.speed:g}"
+        )
+    return ros2_options_from(args)

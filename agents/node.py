@@ -15,7 +15,7 @@ from agents.robot import Robot, SimulatedUnicycle
 from model.coverage_map import load_kernels as load_map_kernels
 from model.ground import NO_FIELD
 from model.parameters import law_parameters, safety_parameters, starting_poses
-from model.safety import PARKED, RAN_LATE, TEAMMATE, filter_command
+from model.safety import PARKED, POSE_STALE, RAN_LATE, TEAMMATE, filter_command
 from model.safety import load_kernels as load_safety_kernels
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, load_kernels
@@ -212,6 +212,8 @@ class AgentNode:
         assert self.objective is not None
         pose = self.robot.pose()
         me = self.options.agent
+        if not self.robot.pose_is_current():
+            return self.hold_step(pose)
         self.positions[me] = pose[:2]
         field = self.world.field(*self.objective) if self.ground.walls else NO_FIELD
         v, omega, e_omega, row0, col0, ticks = decide_and_sense(
@@ -237,8 +239,19 @@ class AgentNode:
         delta = MapDelta(self.options.agent, self.step, row0, col0, ticks)
         self.replica.apply(delta)
         next_pose = self.robot.command(v, omega)
+        v, omega = self.robot.last_command  # a real base's limits may have cut it
         stamp = time.time() if self.options.clock == "realtime" else 0.0  # a team clock for the safety record
         state = AgentState(self.options.agent, self.step, pose, v, omega, e_omega, next_pose, flags, stamp)
+        self.step += 1
+        return delta, state
+
+    def hold_step(self, pose: Pose) -> tuple[MapDelta, AgentState]:
+        """A step without a current pose (a real base whose odometry stopped): the robot is sent zero and
+        senses nothing, as where it is is not known; the step still counts so the sequence goes on."""
+        next_pose = self.robot.command(0.0, 0.0)
+        delta = MapDelta(self.options.agent, self.step, 0, 0, np.zeros((0, 0), dtype=np.int64))
+        self.replica.apply(delta)
+        state = AgentState(self.options.agent, self.step, pose, 0.0, 0.0, 0.0, next_pose, POSE_STALE, time.time())
         self.step += 1
         return delta, state
 

@@ -22,7 +22,10 @@ from __future__ import annotations
 import logging
 import os
 import time
+from collections.abc import Iterator
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import zenoh
 
@@ -31,9 +34,13 @@ from model.scenario import Scenario
 from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_digest, digest_of
 from protocol.messages import AgentState, AgentStep, MapDelta, encode
 from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
-from protocol.session import open_session, team_publisher
+from protocol.session import open_session, team_publisher, zenoh_config
 from runtime.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
 from runtime.rundir import write_counts
+
+if TYPE_CHECKING:
+    from agents.ros2.driver import Ros2Robot
+    from agents.ros2.options import Ros2Options
 
 log = logging.getLogger("anicov.agent")
 
@@ -41,30 +48,64 @@ HELLO_PERIOD = 0.2
 """Seconds between repeated hellos until the coordinator's first go arrives."""
 
 
-def run_agent(scenario: Scenario, options: AgentOptions, config: zenoh.Config, stop: StopFlag) -> int:
-    node = AgentNode(scenario, options)
+def run_agent(
+    scenario: Scenario, options: AgentOptions, config: zenoh.Config, stop: StopFlag, ros2: Ros2Options | None = None
+) -> int:
     parent = os.getppid()
+    with open_session(config) as session, robot_of(session, scenario, options, ros2) as robot:
+        if robot is not None and not robot.wait_for_pose(lambda: stop.stopped, lambda: parent_is_gone(parent)):
+            return stop.exit_code(EXIT_FAILED)  # the robot's pose never came: nothing was commanded
+        node = AgentNode(scenario, options, robot)
+        code = run_on_bus(session, node, stop, parent)
+    write_counts(options.counts_file, node.counts())
+    return code
+
+
+@contextmanager
+def robot_of(
+    session: zenoh.Session, scenario: Scenario, options: AgentOptions, ros2: Ros2Options | None
+) -> Iterator[Ros2Robot | None]:
+    """The ROS 2 base (None: the simulated unicycle, made by the node). However the block ends (end of
+    run, signal, exception) the base is sent zero before the sessions close."""
+    if ros2 is None:
+        yield None
+        return
+    from agents.ros2.driver import Ros2Robot
+
+    with ExitStack() as stack:
+        robot_session = session
+        if ros2.connect:  # the robot's own bridge or router
+            robot_session = stack.enter_context(open_session(zenoh_config("client", connect=list(ros2.connect))))
+        robot = Ros2Robot(robot_session, ros2, scenario, options.agent)
+        stack.callback(robot.close)
+        yield robot
+
+
+def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: int) -> int:
+    """Join the team, step until the run ends, stop the robot and finish the run."""
+    options = node.options
     lockstep = options.clock == "lockstep"
-    with open_session(config) as session:
-        bus = declare_endpoints(session, node, lockstep)
-        if resume_from_snapshot(session, node):
-            # Lockstep: it says hello like a new robot, and the coordinator lists it again from its next go.
-            node.rejoining = lockstep
-            log.info("agent %d resumes from the coordinator's snapshot after step %d", options.agent, node.step - 1)
-        try:
-            wait_until_admitted(bus, stop, parent)
-        except ScenarioMismatch as error:
-            log.error("agent %d refuses to join: %s", options.agent, error)
-            bus.token.undeclare()
-            return EXIT_USAGE
-        log.info("agent %d starts (%s clock)", options.agent, options.clock)
+    bus = declare_endpoints(session, node, lockstep)
+    if resume_from_snapshot(session, node):
+        # Lockstep: it says hello like a new robot, and the coordinator lists it again from its next go.
+        node.rejoining = lockstep
+        log.info("agent %d resumes from the coordinator's snapshot after step %d", options.agent, node.step - 1)
+    try:
+        wait_until_admitted(bus, stop, parent)
+    except ScenarioMismatch as error:
+        log.error("agent %d refuses to join: %s", options.agent, error)
+        bus.token.undeclare()
+        return EXIT_USAGE
+    log.info("agent %d starts (%s clock)", options.agent, options.clock)
+    try:
         if lockstep:
             run_lockstep_steps(bus, stop, parent)
         else:
-            run_realtime_steps(bus, scenario.dt / options.speed, stop, parent)
-        finish_run(bus, lockstep)
-        bus.token.undeclare()
-    write_counts(options.counts_file, node.counts())
+            run_realtime_steps(bus, node.scenario.dt / options.speed, stop, parent)
+    finally:
+        node.robot.stop()  # before the end-of-run exchanges: a real base must not roll on meanwhile
+    finish_run(bus, lockstep)
+    bus.token.undeclare()
     return exit_code(node, stop)
 
 

@@ -1,7 +1,8 @@
 """The robot behind an agent: where it is and how it is commanded.
 
 A real robot driver implements :class:`Robot` (read the localisation, send
-(v, ω) to the base); :class:`SimulatedUnicycle` integrates eq. 1 instead.
+(v, ω) to the base; :class:`agents.ros2.driver.Ros2Robot` for ROS 2 bases);
+:class:`SimulatedUnicycle` integrates eq. 1 instead.
 """
 
 from __future__ import annotations
@@ -18,8 +19,22 @@ class Robot(Protocol):
         """Current (x, y, θ) in domain coordinates."""
         ...
 
+    def pose_is_current(self) -> bool:
+        """The pose is fresh enough to act on; False: the agent holds the robot still this step."""
+        ...
+
     def command(self, v: float, omega: float) -> Pose:
-        """Apply (v, ω) for one control period; return the pose at its end."""
+        """Apply (v, ω) for one control period; return the pose at its end (a real base: the pose it
+        reaches if it follows the command)."""
+        ...
+
+    def stop(self) -> None:
+        """Zero velocity now (the end of the run, a signal, an error)."""
+        ...
+
+    @property
+    def last_command(self) -> tuple[float, float]:
+        """The (v, ω) the last :meth:`command` applied: a real base's limits may have clamped it."""
         ...
 
 
@@ -31,9 +46,18 @@ class SimulatedUnicycle:
         self._law = law
         self._ground = ground  # walls stop it as they stop the engine's robots
 
+        self.last_command = (0.0, 0.0)
+
     def pose(self) -> Pose:
         return self._pose
 
+    def pose_is_current(self) -> bool:
+        return True
+
     def command(self, v: float, omega: float) -> Pose:
+        self.last_command = (v, omega)
         self._pose = move(*self._pose, v, omega, self._law, self._ground)
         return self._pose
+
+    def stop(self) -> None:
+        self.last_command = (0.0, 0.0)

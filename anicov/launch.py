@@ -21,6 +21,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from anicov.ros2_team import add_ros2_team_arguments, check_ros2_team, ros2_agent_flags, test_base_commands
 from model.scenario import Scenario
 from runtime.arguments import add_team_arguments, scenario_from_arguments
 from runtime.lifecycle import (
@@ -57,6 +58,8 @@ class Child:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="launch_team.py", description=__doc__.split("\n\n")[0])
     add_team_arguments(parser)
+    parser.set_defaults(speed=None)  # given or not: a ROS 2 team's speed is the real one (anicov.ros2_team)
+    add_ros2_team_arguments(parser)
     parser.add_argument(
         "--listen",
         help="router endpoint (default tcp/127.0.0.1:7447, or the --secure profile's tls endpoint)",
@@ -205,8 +208,10 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     setup_logging("launch")
     stop = StopFlag().install()
+    speed_given, args.speed = args.speed is not None, 10.0 if args.speed is None else args.speed
     try:
         scenario = scenario_from_arguments(args)
+        check_ros2_team(args, scenario, speed_given)
         router_config_file = apply_secure_profile(args, scenario.agents)
     except ValueError as error:  # ScenarioError, or a --secure profile that does not fit
         print(f"launch_team: error: {error}", file=sys.stderr)
@@ -228,6 +233,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"launch_team: error: cannot open the router on {args.listen}: {error}", file=sys.stderr)
         return EXIT_USAGE
     children: list[Child] = []
+    # Stand-in ROS 2 bases (--test-bases): up before the agents wait for their poses, stopped after them.
+    bases = [spawn(f"base-{i}", command, logs) for i, command in enumerate(test_base_commands(args, scenario, logs))]
     with router:
         keys, watch = TeamKeys(args.team), ControlWatch(scenario)
         router.declare_subscriber(keys.control, watch.on_sample)
@@ -240,6 +247,7 @@ def main(argv: list[str] | None = None) -> int:
                 # After the end of the run every child leaves by itself (the logger flushes first).
                 wait_for_exit(children, GRACE_SECONDS)
             stop_children(children)
+            stop_children(bases)
     if stop.stopped:
         print(f"launch_team: stopped by signal; every child stopped. Logs in {logs}", file=sys.stderr)
         return stop.exit_code(EXIT_FAILED)
@@ -283,6 +291,7 @@ def start_team(args: argparse.Namespace, agents: int, out_dir: Path, children: l
         children.append(spawn("logger", child_command("logger", args, logger_flags), logs))
     for agent in range(agents):
         agent_flags = ["--id", str(agent), "--counts", str(logs / f"agent-{agent}.counts.json")]
+        agent_flags += ros2_agent_flags(args, agent)
         name = f"agent-{agent}"
         children.append(spawn(name, child_command("agent", args, agent_flags, identity=name), logs))
     return coordinator_command

@@ -47,6 +47,7 @@ STALE_NEIGHBOUR = 8  # a teammate in range sent no pose for max_pose_age: stoppe
 DEADLOCK_FOUND = 16  # held by a teammate for STUCK_STEPS: the detour starts
 DEADLOCK_RESOLVED = 32  # the law's command passes again after a detour
 RAN_LATE = 64  # realtime: the control loop fell behind its clock; the robot held still for this step
+POSE_STALE = 128  # a real base sent no pose for its timeout: held still, nothing sensed (agents.ros2)
 
 STUCK_STEPS = 10
 """Steps a robot may be held by a teammate (moving at under HELD_FRACTION of the law's speed) before

@@ -64,6 +64,9 @@ class Scenario:
     max_pose_age: float = 0.5
     initial_poses: tuple[tuple[float, float, float], ...] = ()  # (x, y, θ in degrees) per robot
     objectives: tuple[tuple[float, float], ...] = ()  # fixed, instead of Algorithms 1-2
+    # Units (issue 15): what a length and a time unit are on a real robot (ROS: metres, seconds).
+    metres_per_unit: float = 1.0
+    seconds_per_unit: float = 1.0
 
     @property
     def half_angle(self) -> float:
@@ -91,6 +94,9 @@ class Scenario:
         values["obstacles"] = [[list(point) for point in polygon] for polygon in self.obstacles]
         for key in TERRAIN_KEYS:
             if getattr(self, key) == getattr(_OPEN_WORLD, key) or (key == "occlusion" and not self.has_terrain):
+                del values[key]
+        for key in UNIT_KEYS:
+            if getattr(self, key) == getattr(_OPEN_WORLD, key):
                 del values[key]
         for key in SAFETY_DEFAULTS:
             unused = key not in ("initial_poses", "objectives") and not self.robot_radius > 0.0
@@ -120,6 +126,7 @@ class Scenario:
         return validate(self.to_dict() | given)
 
 
+UNIT_KEYS = ("metres_per_unit", "seconds_per_unit")
 TERRAIN_KEYS = ("map", "obstacles", "robot_radius", "occlusion", "priority_map", "lambda_star_min")
 _OPEN_WORLD = Scenario()
 
@@ -134,6 +141,7 @@ _POSITIVE_FLOATS = (
     "k_omega",
     "max_time",
     "replan_period",
+    *UNIT_KEYS,
 )
 
 
@@ -203,6 +211,11 @@ def _check_whole(scenario: Scenario) -> Scenario:
         raise ScenarioError(
             "scenario key 'controller': 'zigzag' flies the open domain's lanes and knows no walls or robot "
             "bodies; with map, obstacles or robot_radius use one of paper, paper-literal, paper-eq16"
+        )
+    if scenario.map and scenario.metres_per_unit != 1.0:
+        raise ScenarioError(
+            f"scenario key 'metres_per_unit': a scenario with a map is in the map's units (a Nav2 map's are "
+            f"metres): expected 1, got {scenario.metres_per_unit}"
         )
     try:
         check_safety(scenario)

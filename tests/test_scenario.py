@@ -45,6 +45,8 @@ def test_paper_file_has_exactly_the_documented_keys(paper_scenario, tmp_path):
         ("cell", 0.3, "'cell': expected a size that divides the domain"),
         ("seed", -1, "'seed': expected a non-negative integer"),
         ("beta", True, "'beta': expected a finite number"),
+        ("metres_per_unit", 0.0, "'metres_per_unit': expected a positive number"),
+        ("seconds_per_unit", -1.0, "'seconds_per_unit': expected a positive number"),
     ],
 )
 def test_bad_values_name_the_key_and_what_is_expected(key, value, expected):
@@ -81,3 +83,18 @@ def test_overrides_are_validated_and_defaults_kept():
     assert scenario.agents == 7 and scenario.seed == 0
     with pytest.raises(ScenarioError):
         Scenario().with_overrides(agents=-1)
+
+
+def test_units_default_to_one_and_stay_out_of_the_papers_dict(paper_scenario):
+    assert (paper_scenario.metres_per_unit, paper_scenario.seconds_per_unit) == (1.0, 1.0)
+    assert "metres_per_unit" not in paper_scenario.to_dict() and "seconds_per_unit" not in paper_scenario.to_dict()
+    scaled = paper_scenario.with_overrides(metres_per_unit=0.05)
+    assert scaled.to_dict()["metres_per_unit"] == 0.05
+
+
+def test_a_map_is_in_its_own_units(tmp_path):
+    from tests.conftest import ROOT
+
+    office = load_scenario(ROOT / "scenarios" / "office.toml")
+    with pytest.raises(ScenarioError, match="'metres_per_unit': a scenario with a map is in the map's units"):
+        office.with_overrides(metres_per_unit=0.5)

@@ -1,0 +1,56 @@
+"""Frames and units between a ROS 2 base and the scenario (pure functions).
+
+ROS states poses in metres and radians in the ``map`` frame (REP 103/105); a scenario states lengths in
+its own units (``metres_per_unit``) and time in its own (``seconds_per_unit``), with its (0, 0) at the
+lower-left corner of its domain. With a Nav2 map the two frames differ only by the map's ``origin``
+(docs/terrain.md: world = model + origin) and the units are metres.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+Pose = tuple[float, float, float]
+
+
+def yaw_of_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """The heading (rotation about z) of a unit quaternion, in (−π, π]: ZYX Euler yaw."""
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def compose(offset: Pose, pose: Pose) -> Pose:
+    """``offset`` ⊕ ``pose``: a pose given in a frame whose own pose is ``offset`` (map ← odom), in the
+    outer frame. θ is wrapped to (−π, π]."""
+    ox, oy, otheta = offset
+    x, y, theta = pose
+    c, s = math.cos(otheta), math.sin(otheta)
+    heading = math.atan2(math.sin(otheta + theta), math.cos(otheta + theta))
+    return ox + c * x - s * y, oy + s * x + c * y, heading
+
+
+@dataclass(frozen=True)
+class ScenarioFrame:
+    """Where the scenario sits in the robot's map frame, and its units."""
+
+    origin: tuple[float, float] = (0.0, 0.0)  # map-frame (x, y) of the scenario's (0, 0), metres
+    metres_per_unit: float = 1.0
+    seconds_per_unit: float = 1.0
+
+    def to_scenario(self, map_pose: Pose) -> Pose:
+        """A map-frame pose (metres) in scenario units; the heading is the same (no rotation between)."""
+        x, y, theta = map_pose
+        return (x - self.origin[0]) / self.metres_per_unit, (y - self.origin[1]) / self.metres_per_unit, theta
+
+    def to_map(self, x: float, y: float) -> tuple[float, float]:
+        """A scenario point (units) in the map frame (metres): the inverse of :meth:`to_scenario`."""
+        return self.origin[0] + x * self.metres_per_unit, self.origin[1] + y * self.metres_per_unit
+
+    def to_ros_velocity(self, v: float, omega: float) -> tuple[float, float]:
+        """(v, ω) in scenario units per time unit as (m/s, rad/s)."""
+        return v * self.metres_per_unit / self.seconds_per_unit, omega / self.seconds_per_unit
+
+
+def clamp(value: float, limit: float) -> float:
+    """``value`` in [−limit, limit]."""
+    return max(-limit, min(limit, value))

@@ -1,0 +1,208 @@
+"""agents.ros2.driver over real Zenoh sessions on loopback: a stand-in base made of rosbags and zenoh only
+checks what the driver publishes, and feeds it poses."""
+
+from __future__ import annotations
+
+import math
+import queue
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import numpy as np
+import pytest
+import zenoh
+import zenoh.ext
+from rosbags.typesys import Stores, get_typestore
+
+from agents.ros2.driver import Ros2Robot
+from agents.ros2.options import Ros2Options
+from model.scenario import Scenario
+from protocol.session import zenoh_config
+from tests.teamrun import free_port
+
+STORE = get_typestore(Stores.ROS2_JAZZY)
+T = STORE.types
+SCENARIO = Scenario(metres_per_unit=0.05, seconds_per_unit=0.05)  # 1 unit per time unit = 1 m/s
+
+
+@contextmanager
+def bus() -> Iterator[tuple[zenoh.Session, zenoh.Session]]:
+    """A router on a free loopback port and two clients: the driver's and the base's."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    with (
+        zenoh.open(zenoh_config("router", listen=[endpoint])),
+        zenoh.open(zenoh_config(connect=[endpoint])) as driver,
+        zenoh.open(zenoh_config(connect=[endpoint])) as base,
+    ):
+        yield driver, base
+
+
+class Base:
+    """What a base receives on its command key, decoded by rosbags; odometry it sends."""
+
+    def __init__(self, session: zenoh.Session, command_key: str, typename: str = "geometry_msgs/msg/Twist") -> None:
+        self.received: queue.Queue[tuple[object, bytes | None]] = queue.Queue()
+        self.typename = typename
+        session.declare_subscriber(command_key, self.on_command)
+        self.session = session
+        self.streaming = threading.Event()
+
+    def stream_odometry(self, key: str, x: float, y: float, theta: float) -> None:
+        """Odometry at 30 Hz, as a base sends it, until :meth:`stop_odometry`."""
+        self.streaming.set()
+
+        def loop() -> None:
+            while self.streaming.is_set():
+                self.send_odometry(key, x, y, theta)
+                time.sleep(1 / 30)
+
+        threading.Thread(target=loop, daemon=True).start()
+
+    def stop_odometry(self) -> None:
+        self.streaming.clear()
+        time.sleep(0.1)
+
+    def on_command(self, sample: zenoh.Sample) -> None:
+        message = STORE.deserialize_cdr(sample.payload.to_bytes(), self.typename)
+        attachment = sample.attachment.to_bytes() if sample.attachment is not None else None
+        self.received.put((message, attachment))
+
+    def next(self) -> tuple[object, bytes | None]:
+        return self.received.get(timeout=5.0)
+
+    def send_odometry(self, key: str, x: float, y: float, theta: float) -> None:
+        pose = T["geometry_msgs/msg/Pose"](
+            position=T["geometry_msgs/msg/Point"](x=x, y=y, z=0.0),
+            orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=math.sin(theta / 2), w=math.cos(theta / 2)),
+        )
+        zero = T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
+        message = T["nav_msgs/msg/Odometry"](
+            header=T["std_msgs/msg/Header"](stamp=T["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="odom"),
+            child_frame_id="base_link",
+            pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=np.zeros(36)),
+            twist=T["geometry_msgs/msg/TwistWithCovariance"](
+                twist=T["geometry_msgs/msg/Twist"](linear=zero, angular=zero), covariance=np.zeros(36)
+            ),
+        )
+        self.session.put(key, bytes(STORE.serialize_cdr(message, "nav_msgs/msg/Odometry")))
+
+
+def wait_until(condition, timeout: float = 5.0) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        time.sleep(0.01)
+    return False
+
+
+def robot_with_pose(driver: zenoh.Session, base: Base, options: Ros2Options, pose=(1.0, 2.0, 0.5)) -> Ros2Robot:
+    robot = Ros2Robot(driver, options, SCENARIO, agent=0)
+    base.stream_odometry(robot.topics.pose_key, *pose)
+    assert wait_until(robot.has_pose)
+    return robot
+
+
+def test_commands_are_twists_in_metres_and_radians_clamped_to_the_paper_and_the_base():
+    options = Ros2Options(namespace="bot1", max_linear=0.5, max_angular=10.0)
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = robot_with_pose(driver, base, options)
+        assert robot.pose() == pytest.approx((20.0, 40.0, 0.5))  # (1 m, 2 m) in units of 0.05 m
+        robot.command(0.4, 0.1)
+        twist, attachment = base.next()
+        assert attachment is None  # the bridge route carries none
+        assert twist.linear.x == pytest.approx(0.4) and twist.angular.z == pytest.approx(2.0)  # 0.1 rad / 0.05 s
+        robot.command(3.0, -5.0)  # past k_v = 1 and π k_ω; then past the base's 0.5 m/s and 10 rad/s
+        twist, _ = base.next()
+        assert twist.linear.x == pytest.approx(0.5) and twist.angular.z == pytest.approx(-10.0)
+        assert robot.last_command == pytest.approx((0.5, -0.5))  # what was applied, in scenario units
+        base.stop_odometry()
+        robot.close()
+        twist, _ = base.next()
+        assert (twist.linear.x, twist.angular.z) == (0.0, 0.0)
+
+
+def test_rmw_zenoh_commands_go_to_the_hashed_key_with_the_attachment():
+    options = Ros2Options(namespace="robot1", transport="rmw-zenoh", stamped=True, frame_id="robot1/base_link")
+    with bus() as (driver, base_session):
+        typename = "geometry_msgs/msg/TwistStamped"
+        key = "0/robot1/cmd_vel/geometry_msgs::msg::dds_::TwistStamped_/" + STORE.hash_rihs01(typename)
+        base = Base(base_session, key, typename)
+        robot = robot_with_pose(driver, base, options)
+        assert robot.topics.pose_key == "0/robot1/odom/nav_msgs::msg::dds_::Odometry_/" + STORE.hash_rihs01(
+            "nav_msgs/msg/Odometry"
+        )
+        before = time.time_ns()
+        robot.command(0.2, 0.0)
+        robot.command(0.3, 0.0)
+        (first, first_attachment), (second, second_attachment) = base.next(), base.next()
+        assert (first.twist.linear.x, second.twist.linear.x) == pytest.approx((0.2, 0.3))
+        assert second.header.frame_id == "robot1/base_link"
+        assert second.header.stamp.sec * 10**9 + second.header.stamp.nanosec >= before
+        read = [
+            zenoh.ext.z_deserialize(tuple[zenoh.ext.Int64, zenoh.ext.Int64, bytes], zenoh.ZBytes(a))
+            for a in (first_attachment, second_attachment)
+        ]
+        assert [len(a) for a in (first_attachment, second_attachment)] == [33, 33]
+        assert read[1][0] == read[0][0] + 1 and read[0][2] == read[1][2] and len(read[0][2]) == 16
+        assert read[1][1] >= before
+        base.stop_odometry()
+        robot.close()
+
+
+def test_a_stale_pose_sends_zero_until_a_fresh_one_arrives():
+    options = Ros2Options(namespace="bot1", pose_timeout=0.2)
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = robot_with_pose(driver, base, options)
+        assert robot.pose_is_current()
+        base.stop_odometry()
+        time.sleep(0.3)
+        assert not robot.pose_is_current()
+        robot.command(1.0, 0.5)
+        twist, _ = base.next()
+        assert (twist.linear.x, twist.angular.z) == (0.0, 0.0) and robot.last_command == (0.0, 0.0)
+        base.stream_odometry("bot1/odom", 1.0, 2.0, 0.5)
+        assert wait_until(robot.pose_is_current)
+        robot.command(1.0, 0.0)
+        twist, _ = base.next()
+        assert twist.linear.x == pytest.approx(1.0)
+        base.stop_odometry()
+        robot.close()
+
+
+def test_odometry_is_placed_by_the_map_from_odom_offset_and_the_origin():
+    offset = (2.0, 1.0, math.pi / 2)
+    options = Ros2Options(namespace="bot1", odom_offset=offset, origin=(-1.0, 0.0))
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = robot_with_pose(driver, base, options, pose=(1.0, 0.0, 0.0))
+        # odom (1, 0, 0) is map (2, 2, π/2); the scenario's (0, 0) is map (−1, 0); units of 0.05 m.
+        assert robot.pose() == pytest.approx((60.0, 40.0, math.pi / 2))
+        base.stop_odometry()
+        robot.close()
+
+
+def test_a_payload_that_is_not_a_pose_is_rejected_and_counted():
+    with bus() as (driver, base_session):
+        robot = Ros2Robot(driver, Ros2Options(namespace="bot1"), SCENARIO, agent=0)
+        assert wait_until(
+            lambda: (base_session.put("bot1/odom", b"\x00\x01\x00\x00 not odometry"), robot.poses_rejected)[1]
+        )
+        assert not robot.has_pose()
+        with pytest.raises(RuntimeError, match="no pose yet on bot1/odom"):
+            robot.pose()
+        robot.close()
+
+
+def test_waiting_for_a_pose_says_where_and_gives_up_when_stopped(caplog):
+    with bus() as (driver, _):
+        robot = Ros2Robot(driver, Ros2Options(namespace="bot7"), SCENARIO, agent=3)
+        calls = iter(range(3))
+        with caplog.at_level("INFO", logger="anicov.ros2"):
+            assert not robot.wait_for_pose(lambda: next(calls, 3) >= 2, lambda: False)
+        assert "agent 3 waits for its robot's pose: nav_msgs/msg/Odometry on Zenoh key bot7/odom" in caplog.text
+        robot.close()

@@ -1,0 +1,54 @@
+"""agents.ros2.frames: quaternions, map ← odom, scenario units."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from agents.ros2.frames import ScenarioFrame, clamp, compose, yaw_of_quaternion
+
+angles = st.floats(-math.pi + 1e-6, math.pi, allow_nan=False)
+coordinates = st.floats(-1e3, 1e3, allow_nan=False)
+
+
+@given(angles)
+def test_yaw_of_a_rotation_about_z_is_its_angle(theta):
+    assert yaw_of_quaternion(0.0, 0.0, math.sin(theta / 2), math.cos(theta / 2)) == pytest.approx(theta, abs=1e-9)
+
+
+def test_yaw_ignores_roll_of_a_flat_robot_turned_upside_down_as_ros_does():
+    # A rotation of π about x (roll) has no yaw; ZYX Euler yaw of (1, 0, 0, 0) is 0.
+    assert yaw_of_quaternion(1.0, 0.0, 0.0, 0.0) == pytest.approx(0.0)
+
+
+def test_compose_places_odometry_in_the_map_frame():
+    # odom's origin at (2, 1) in the map, turned 90°: 1 m ahead in odom is 1 m along map y.
+    x, y, theta = compose((2.0, 1.0, math.pi / 2), (1.0, 0.0, 0.0))
+    assert (x, y, theta) == pytest.approx((2.0, 2.0, math.pi / 2))
+
+
+@given(coordinates, coordinates, angles, coordinates, coordinates, angles)
+def test_compose_with_the_identity_changes_nothing_and_wraps_the_heading(ox, oy, ot, x, y, t):
+    assert compose((0.0, 0.0, 0.0), (x, y, t)) == pytest.approx((x, y, t), abs=1e-9)
+    heading = compose((ox, oy, ot), (x, y, t))[2]
+    assert -math.pi <= heading <= math.pi
+
+
+@given(coordinates, coordinates)
+def test_map_and_scenario_frames_are_inverse(x, y):
+    frame = ScenarioFrame((-3.5, 12.0), metres_per_unit=0.05, seconds_per_unit=0.2)
+    mx, my = frame.to_map(x, y)
+    assert frame.to_scenario((mx, my, 0.3)) == pytest.approx((x, y, 0.3), abs=1e-6)
+
+
+def test_velocities_scale_by_the_units():
+    frame = ScenarioFrame(metres_per_unit=0.05, seconds_per_unit=0.1)
+    # 1 unit per time unit is 0.05 m per 0.1 s; 1 rad per time unit is 10 rad/s.
+    assert frame.to_ros_velocity(1.0, 1.0) == pytest.approx((0.5, 10.0))
+
+
+def test_clamp_is_symmetric():
+    assert clamp(3.0, 2.0) == 2.0 and clamp(-3.0, 2.0) == -2.0 and clamp(1.5, 2.0) == 1.5
