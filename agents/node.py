@@ -87,6 +87,10 @@ class AgentNode:
                 self.replica.apply(message.delta)
                 self.relay.add(message.agent, message.delta.seq, item.payload)
                 self.note_position(message.state)
+        elif isinstance(message, AgentState) and message.step < 0 and message.agent != self.options.agent:
+            # Realtime, a teammate's hello: where its robot really is (a real base need not stand at the
+            # seeded start), for the line of sight and the safety filter before its first step arrives.
+            self.note_position(message)
         elif isinstance(message, StepGo):
             if message.step >= self.step:
                 self.gos[message.step] = message

@@ -354,6 +354,7 @@ def report(
         print(
             f"  processes       coordinator + {agents} agents"
             + ("" if args.no_record else " + logger")
+            + (f" + {agents} stand-in ROS 2 bases" if args.test_bases else "")
             + f", logs in {logs}"
         )
         if seen.lost:

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import csv
+import itertools
+import json
+import math
 import os
 import signal
 import socket
@@ -99,3 +103,32 @@ def write_scenario(path: Path, **values: object) -> Path:
         lines.append(f"{key} = {value!r}".replace("'", '"') if not isinstance(value, list) else f"{key} = {value}")
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def check_realtime_run(run_dir: Path, k_v: float, k_omega: float, dt: float) -> dict:
+    """The checks every realtime run passes, simulated robots or real bases (returns summary.json):
+    complete with e_D = 0; trajectory.csv in its form, every robot's steps dt apart (none lost); commands within the
+    paper's bounds (|v| ≤ k_v, |ω| ≤ π k_ω, eq. 15-16); and each robot's path measured from its poses
+    within 3 % of the path its commands ask for (Σ |v| dt): the robot moved as it was told."""
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert summary["completed"] is True and summary["final_error"] == 0.0, summary
+    with open(run_dir / "trajectory.csv", newline="") as file:
+        assert file.readline() == "t,agent,x,y,theta,v,omega\n"
+        file.seek(0)
+        rows = list(csv.DictReader(file))
+    by_agent: dict[int, list[dict[str, float]]] = {}
+    for row in rows:
+        by_agent.setdefault(int(row["agent"]), []).append({key: float(value) for key, value in row.items()})
+    assert sorted(by_agent) == list(range(summary["scenario"]["agents"]))
+    for agent, steps in by_agent.items():
+        times = [step["t"] for step in steps]
+        # The last row is the pose at the run's end, which a robot stepping on its own clock may reach a
+        # step or two after its last state the coordinator heard.
+        assert all(math.isclose(b - a, dt, rel_tol=1e-6) for a, b in itertools.pairwise(times[:-1])), agent
+        assert 0 < times[-1] - times[-2] <= 3 * dt + 1e-9, agent
+        assert max(abs(step["v"]) for step in steps) <= k_v + 1e-9
+        assert max(abs(step["omega"]) for step in steps) <= math.pi * k_omega + 1e-9
+        measured = sum(math.hypot(b["x"] - a["x"], b["y"] - a["y"]) for a, b in itertools.pairwise(steps))
+        commanded = sum(abs(step["v"]) * dt for step in steps[:-1])
+        assert abs(measured - commanded) <= 0.03 * commanded, (agent, measured, commanded)
+    return summary

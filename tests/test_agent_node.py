@@ -204,3 +204,12 @@ def test_a_control_step_covers_our_own_replica_and_moves_the_robot():
     assert node.step == 1
     counts = node.counts()
     assert counts["steps"] == 1 and counts["teammates_left"] == [] and counts["applied"] == {"1": 0}
+
+
+def test_a_teammates_hello_tells_where_its_robot_really_is():
+    node = node_for(agent=0, clock="realtime")
+    hello = AgentState(2, -1, (40.0, 60.0, 1.0), 0.0, 0.0, 0.0, (40.0, 60.0, 1.0))
+    node.handle(Received("agent", hello))
+    assert tuple(node.poses[2]) == (40.0, 60.0, 1.0) and tuple(node.positions[2]) == (40.0, 60.0)
+    node.handle(Received("agent", AgentState(0, -1, (1.0, 1.0, 0.0), 0.0, 0.0, 0.0, (1.0, 1.0, 0.0))))
+    assert tuple(node.poses[0]) != (1.0, 1.0, 0.0)  # our own echo is not a teammate

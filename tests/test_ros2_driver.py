@@ -206,3 +206,23 @@ def test_waiting_for_a_pose_says_where_and_gives_up_when_stopped(caplog):
             assert not robot.wait_for_pose(lambda: next(calls, 3) >= 2, lambda: False)
         assert "agent 3 waits for its robot's pose: nav_msgs/msg/Odometry on Zenoh key bot7/odom" in caplog.text
         robot.close()
+
+
+def test_a_crash_in_the_control_loop_still_sends_zero():
+    """agents.process.robot_of: however the agent's block ends, the base is sent zero before the
+    sessions close (here an exception, as a bug in the control loop would raise)."""
+    from agents.process import AgentOptions, robot_of
+
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        with pytest.raises(RuntimeError, match="a bug"):
+            with robot_of(driver, SCENARIO, AgentOptions("t", 0), Ros2Options(namespace="bot1")) as robot:
+                base.stream_odometry("bot1/odom", 1.0, 2.0, 0.5)
+                assert wait_until(robot.has_pose)
+                robot.command(0.7, 0.0)
+                raise RuntimeError("a bug in the control loop")
+        base.stop_odometry()
+        moving, _ = base.next()
+        stopped, _ = base.next()
+        assert moving.linear.x == pytest.approx(0.7)
+        assert (stopped.linear.x, stopped.angular.z) == (0.0, 0.0) and base.received.empty()

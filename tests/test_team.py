@@ -9,6 +9,7 @@ import pytest
 
 from tests.teamrun import (
     anicov,
+    check_realtime_run,
     launched_team,
     launcher_command,
     processes_of,
@@ -66,12 +67,10 @@ def test_realtime_clock_completes_within_15_percent_of_lockstep(tmp_path):
         timeout=400,
     )
     assert launched.returncode == 0, launched.stderr + launched.stdout
-    summary = json.loads((tmp_path / "rt" / "summary.json").read_text())
-    assert summary["completed"] is True and summary["final_error"] == 0.0
+    summary = check_realtime_run(tmp_path / "rt", k_v=1.0, k_omega=1.0, dt=0.1)  # as tests/test_ros2_team.py's
     ratio = summary["completion_time"] / lockstep["completion_time"]
     (tmp_path / "ratio.txt").write_text(f"{ratio:.3f}\n")
     assert 0.85 <= ratio <= 1.15, ratio
-    assert (tmp_path / "rt" / "trajectory.csv").read_text().startswith("t,agent,x,y,theta,v,omega\n")
 
 
 @pytest.mark.parametrize(("number", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"])
