@@ -43,7 +43,9 @@ def ros2_options(args: argparse.Namespace, scenario: Scenario):
 
     require_rosbags()
     if args.clock != "realtime":
-        raise RobotArgumentError("--robot ros2 drives a real base, which cannot wait for a lockstep go: use --clock realtime")
+        raise RobotArgumentError(
+            "--robot ros2 drives a real base, which cannot wait for a lockstep go: use --clock realtime"
+        )
     real_time = 1.0 / scenario.seconds_per_unit
     if abs(args.speed - real_time) > 1e-9 * real_time:
         raise RobotArgumentError(

@@ -138,11 +138,14 @@ class AgentNode:
                 self.replica.apply(delta)
 
     def note_position(self, state: AgentState) -> None:
-        """A teammate's pose at the end of its step (lockstep: every member's, at the start of this step)."""
+        """A teammate's pose at the end of its step (lockstep: every member's, at the start of this step).
+        A step its robot held for want of a pose (POSE_STALE) repeats the last known one: it does not make
+        that pose any younger, so the safety filter's age of it keeps growing."""
         if 0 <= state.agent < len(self.positions) and state.agent != self.options.agent:
             self.positions[state.agent] = state.next_pose[:2]
             self.poses[state.agent] = state.next_pose
-            self.heard_at[state.agent] = time.monotonic()
+            if not state.safety & POSE_STALE:
+                self.heard_at[state.agent] = time.monotonic()
 
     def take_targets(self, objectives: Objectives) -> None:
         target = objectives.target_of(self.options.agent)
@@ -214,10 +217,10 @@ class AgentNode:
         this step is taken standing still. A robot catching up at full speed would move faster than
         k_v in wall time, beyond what its teammates' margins allow for (a real base's watchdog stops it)."""
         assert self.objective is not None
-        pose = self.robot.pose()
+        pose = self.robot.current_pose()
         me = self.options.agent
-        if not self.robot.pose_is_current():
-            return self.hold_step(pose)
+        if pose is None:
+            return self.hold_step(self.robot.pose())
         self.positions[me] = pose[:2]
         field = self.world.field(*self.objective) if self.ground.walls else NO_FIELD
         v, omega, e_omega, row0, col0, ticks = decide_and_sense(

@@ -34,7 +34,7 @@ from model.scenario import Scenario
 from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_digest, digest_of
 from protocol.messages import AgentState, AgentStep, MapDelta, encode
 from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
-from protocol.session import open_session, team_publisher, zenoh_config
+from protocol.session import RouterUnreachable, open_session, team_publisher, zenoh_config
 from runtime.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
 from runtime.rundir import write_counts
 
@@ -57,7 +57,7 @@ def run_agent(
             return stop.exit_code(EXIT_FAILED)  # the robot's pose never came: nothing was commanded
         node = AgentNode(scenario, options, robot)
         code = run_on_bus(session, node, stop, parent)
-    write_counts(options.counts_file, node.counts())
+    write_counts(options.counts_file, node.counts() | ({"robot": robot.counts()} if robot is not None else {}))
     return code
 
 
@@ -75,7 +75,12 @@ def robot_of(
     with ExitStack() as stack:
         robot_session = session
         if ros2.connect:  # the robot's own bridge or router
-            robot_session = stack.enter_context(open_session(zenoh_config("client", connect=list(ros2.connect))))
+            where = ", ".join(ros2.connect)
+            log.info("agent %d connects to its robot's bridge or router at %s", options.agent, where)
+            try:
+                robot_session = stack.enter_context(open_session(zenoh_config("client", connect=list(ros2.connect))))
+            except RouterUnreachable as error:
+                raise RouterUnreachable(f"the robot's bridge or router at {where}: {error}") from error
         robot = Ros2Robot(robot_session, ros2, scenario, options.agent)
         stack.callback(robot.close)
         yield robot

@@ -16,16 +16,17 @@ from protocol.messages import Pose
 
 class Robot(Protocol):
     def pose(self) -> Pose:
-        """Current (x, y, θ) in domain coordinates."""
+        """The latest (x, y, θ) in domain coordinates, fresh or not (hellos, held steps)."""
         ...
 
-    def pose_is_current(self) -> bool:
-        """The pose is fresh enough to act on; False: the agent holds the robot still this step."""
+    def current_pose(self) -> Pose | None:
+        """The pose this step acts on, read once; None when it is not known to be fresh (a real base's
+        stale odometry): the agent then holds the robot still this step."""
         ...
 
     def command(self, v: float, omega: float) -> Pose:
-        """Apply (v, ω) for one control period; return the pose at its end (a real base: the pose it
-        reaches if it follows the command)."""
+        """Apply (v, ω) for one control period from the pose :meth:`current_pose` gave; return the pose
+        at its end (a real base: the pose it reaches if it follows the command)."""
         ...
 
     def stop(self) -> None:
@@ -45,14 +46,13 @@ class SimulatedUnicycle:
         self._pose = (float(initial[0]), float(initial[1]), float(initial[2]))
         self._law = law
         self._ground = ground  # walls stop it as they stop the engine's robots
-
         self.last_command = (0.0, 0.0)
 
     def pose(self) -> Pose:
         return self._pose
 
-    def pose_is_current(self) -> bool:
-        return True
+    def current_pose(self) -> Pose:
+        return self._pose
 
     def command(self, v: float, omega: float) -> Pose:
         self.last_command = (v, omega)

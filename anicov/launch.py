@@ -58,7 +58,7 @@ class Child:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="launch_team.py", description=__doc__.split("\n\n")[0])
     add_team_arguments(parser)
-    parser.set_defaults(speed=None)  # given or not: a ROS 2 team's speed is the real one (anicov.ros2_team)
+    parser.set_defaults(speed=None, clock=None)  # given or not: a ROS 2 team's are the robots' (anicov.ros2_team)
     add_ros2_team_arguments(parser)
     parser.add_argument(
         "--listen",
@@ -211,7 +211,7 @@ def main(argv: list[str] | None = None) -> int:
     speed_given, args.speed = args.speed is not None, 10.0 if args.speed is None else args.speed
     try:
         scenario = scenario_from_arguments(args)
-        check_ros2_team(args, scenario, speed_given)
+        check_ros2_team(args, scenario, speed_given)  # settles the clock too
         router_config_file = apply_secure_profile(args, scenario.agents)
     except ValueError as error:  # ScenarioError, or a --secure profile that does not fit
         print(f"launch_team: error: {error}", file=sys.stderr)

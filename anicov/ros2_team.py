@@ -39,16 +39,24 @@ def add_ros2_team_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def check_ros2_team(args: argparse.Namespace, scenario: Scenario, speed_given: bool) -> None:
-    """Settle the clock of a ROS 2 team (realtime, speed 1 / seconds_per_unit) or say which flag is wrong."""
+    """Settle the clock (lockstep by default; a ROS 2 team's realtime at speed 1 / seconds_per_unit) or say
+    which flag is wrong."""
     if args.robot != "ros2":
         if args.test_bases:
             raise ScenarioError("--test-bases: stand-in ROS 2 bases need --robot ros2")
+        args.clock = args.clock or "lockstep"
         return
     from agents.ros2 import require_rosbags
 
     require_rosbags()
     if args.test_bases and args.ros_transport != "bridge":
         raise ScenarioError("--test-bases: the stand-in bases speak bridge-style keys; use --ros-transport bridge")
+    if args.test_bases and args.secure:
+        raise ScenarioError(
+            "--test-bases: the stand-in bases are not members of a --secure team (no certificate); with a "
+            "secure profile, bases are reached on the robot's own bridge (deploy/ros2.md)"
+        )
+    args.clock = args.clock or "realtime"
     if args.clock != "realtime":
         raise ScenarioError("--robot ros2: a real base cannot wait for a lockstep go; use --clock realtime")
     real_time = 1.0 / scenario.seconds_per_unit

@@ -1,4 +1,4 @@
-"""Process lifecycle: stop cleanly on SIGINT/SIGTERM, and never outlive the launcher."""
+"""Process lifecycle: stop cleanly on SIGINT, SIGTERM or SIGHUP, and never outlive the launcher."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ EXIT_SIGTERM = 143
 
 
 class StopFlag:
-    """Set by SIGINT or SIGTERM; main loops poll it and leave through their ``with`` blocks.
+    """Set by SIGINT, SIGTERM or SIGHUP; main loops poll it and leave through their ``with`` blocks.
 
     The handler only assigns attributes: it runs between two bytecodes of the
     main thread, which may be holding a lock at that moment (inside
@@ -38,6 +38,7 @@ class StopFlag:
     def install(self) -> StopFlag:
         signal.signal(signal.SIGINT, self._on_signal)
         signal.signal(signal.SIGTERM, self._on_signal)
+        signal.signal(signal.SIGHUP, self._on_signal)  # a closed terminal or SSH link: stop as cleanly
         return self
 
     def _on_signal(self, number: int, _frame: FrameType | None) -> None:
@@ -67,6 +68,8 @@ class StopFlag:
             return EXIT_SIGINT
         if self.signal_number == signal.SIGTERM:
             return EXIT_SIGTERM
+        if self.signal_number is not None:
+            return 128 + self.signal_number  # SIGHUP: 129
         return otherwise
 
 

@@ -22,17 +22,18 @@ def parse(*flags: str) -> argparse.Namespace:
 
 def test_defaults_are_a_bridge_base_with_odometry():
     options = ros2_options_from(parse("--robot", "ros2", "--ros-namespace", "bot1"))
-    assert (options.namespace, options.transport, options.command_topic, options.pose_topic) == (
+    assert (options.namespace, options.transport, options.command_topic, options.odometry_topic) == (
         "bot1",
         "bridge",
         "cmd_vel",
         "odom",
     )
     assert options.max_linear == math.inf and options.origin is None and not options.stamped
+    assert options.localiser_topic is None
 
 
-def test_a_localiser_pose_defaults_to_amcl_pose_and_offsets_are_in_degrees():
-    assert ros2_options_from(parse("--ros-pose-type", "pose")).pose_topic == "amcl_pose"
+def test_a_localiser_topic_and_offsets_in_degrees():
+    assert ros2_options_from(parse("--ros-localiser-topic", "amcl_pose")).localiser_topic == "amcl_pose"
     options = ros2_options_from(parse("--ros-odom-offset", "1", "2", "90", "--ros-origin", "-5", "3"))
     assert options.odom_offset == pytest.approx((1.0, 2.0, math.pi / 2)) and options.origin == (-5.0, 3.0)
 
@@ -44,13 +45,26 @@ def test_a_localiser_pose_defaults_to_amcl_pose_and_offsets_are_in_degrees():
         (("--ros-max-linear", "-1"), "--ros-max-linear"),
         (("--ros-max-angular", "nan"), "--ros-max-angular"),
         (("--ros-domain", "300"), "--ros-domain"),
-        (("--ros-pose-type", "pose", "--ros-odom-offset", "0", "0", "0"), "--ros-odom-offset"),
+        (("--ros-localiser-topic", "amcl_pose", "--ros-odom-offset", "0", "0", "0"), "--ros-odom-offset"),
         (("--ros-origin", "inf", "0"), "--ros-origin"),
+        (("--ros-namespace", "*"), "--ros-namespace"),  # a wildcard would drive every robot
+        (("--ros-namespace", "bot*"), "--ros-namespace"),
+        (("--ros-namespace", "a//b"), "--ros-namespace"),
+        (("--ros-namespace", "2bot"), "--ros-namespace"),
+        (("--ros-cmd-topic", "/"), "--ros-cmd-topic"),
+        (("--ros-odom-topic", "odom/**"), "--ros-odom-topic"),
+        (("--ros-localiser-topic", "~/pose"), "--ros-localiser-topic"),
+        (("--ros-transport", "rmw-zenoh", "--ros-distro", "humble"), "--ros-distro humble"),
     ],
 )
 def test_a_bad_flag_is_refused_by_name(flags, named):
     with pytest.raises(RobotArgumentError, match=named):
         ros2_options_from(parse(*flags))
+
+
+@pytest.mark.parametrize("namespace", ["", "bot1", "/bot1", "fleet/bot_2", "/fleet/bot2/"])
+def test_ros_names_are_accepted(namespace):
+    assert ros2_options_from(parse("--ros-namespace", namespace, "--ros-cmd-topic", "/cmd_vel")).namespace == namespace
 
 
 def test_the_agent_refuses_the_lockstep_clock_for_a_real_base():

@@ -24,7 +24,9 @@ from tests.teamrun import free_port
 
 STORE = get_typestore(Stores.ROS2_JAZZY)
 T = STORE.types
-SCENARIO = Scenario(metres_per_unit=0.05, seconds_per_unit=0.05)  # 1 unit per time unit = 1 m/s
+# 1 unit per time unit = 1 m/s. A control period of 1 s (dt 20 x 0.05 s): the watchdog (3 periods without
+# a command) stays out of these tests but the one about it.
+SCENARIO = Scenario(metres_per_unit=0.05, seconds_per_unit=0.05, dt=20.0)
 
 
 @contextmanager
@@ -72,6 +74,18 @@ class Base:
     def next(self) -> tuple[object, bytes | None]:
         return self.received.get(timeout=5.0)
 
+    def send_localiser_pose(self, key: str, x: float, y: float, theta: float) -> None:
+        """A map-frame PoseWithCovarianceStamped stamped 0, the stamp of every odometry sent here."""
+        pose = T["geometry_msgs/msg/Pose"](
+            position=T["geometry_msgs/msg/Point"](x=x, y=y, z=0.0),
+            orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=math.sin(theta / 2), w=math.cos(theta / 2)),
+        )
+        message = T["geometry_msgs/msg/PoseWithCovarianceStamped"](
+            header=T["std_msgs/msg/Header"](stamp=T["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="map"),
+            pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=np.zeros(36)),
+        )
+        self.session.put(key, bytes(STORE.serialize_cdr(message, "geometry_msgs/msg/PoseWithCovarianceStamped")))
+
     def send_odometry(self, key: str, x: float, y: float, theta: float) -> None:
         pose = T["geometry_msgs/msg/Pose"](
             position=T["geometry_msgs/msg/Point"](x=x, y=y, z=0.0),
@@ -98,31 +112,57 @@ def wait_until(condition, timeout: float = 5.0) -> bool:
     return False
 
 
-def robot_with_pose(driver: zenoh.Session, base: Base, options: Ros2Options, pose=(1.0, 2.0, 0.5)) -> Ros2Robot:
-    robot = Ros2Robot(driver, options, SCENARIO, agent=0)
-    base.stream_odometry(robot.topics.pose_key, *pose)
+def robot_with_pose(
+    driver: zenoh.Session, base: Base, options: Ros2Options, pose=(1.0, 2.0, 0.5), scenario: Scenario = SCENARIO
+) -> Ros2Robot:
+    robot = Ros2Robot(driver, options, scenario, agent=0)
+    base.stream_odometry(robot.topics.odometry_key, *pose)
     assert wait_until(robot.has_pose)
     return robot
 
 
-def test_commands_are_twists_in_metres_and_radians_clamped_to_the_paper_and_the_base():
-    options = Ros2Options(namespace="bot1", max_linear=0.5, max_angular=10.0)
+def test_commands_are_twists_in_metres_and_radians_scaled_into_the_papers_bounds():
     with bus() as (driver, base_session):
         base = Base(base_session, "bot1/cmd_vel")
-        robot = robot_with_pose(driver, base, options)
-        assert robot.pose() == pytest.approx((20.0, 40.0, 0.5))  # (1 m, 2 m) in units of 0.05 m
+        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1"))
+        assert robot.current_pose() == pytest.approx((20.0, 40.0, 0.5))  # (1 m, 2 m) in units of 0.05 m
         robot.command(0.4, 0.1)
         twist, attachment = base.next()
         assert attachment is None  # the bridge route carries none
         assert twist.linear.x == pytest.approx(0.4) and twist.angular.z == pytest.approx(2.0)  # 0.1 rad / 0.05 s
-        robot.command(3.0, -5.0)  # past k_v = 1 and π k_ω; then past the base's 0.5 m/s and 10 rad/s
+        robot.command(3.0, -5.0)  # past k_v = 1 and π k_ω: both scaled by 1/3, the curvature kept
         twist, _ = base.next()
-        assert twist.linear.x == pytest.approx(0.5) and twist.angular.z == pytest.approx(-10.0)
-        assert robot.last_command == pytest.approx((0.5, -0.5))  # what was applied, in scenario units
+        assert twist.linear.x == pytest.approx(1.0) and twist.angular.z == pytest.approx(-5 / 3 / 0.05)
+        assert robot.last_command == pytest.approx((1.0, -5 / 3))
         base.stop_odometry()
         robot.close()
         twist, _ = base.next()
         assert (twist.linear.x, twist.angular.z) == (0.0, 0.0)
+
+
+def test_commands_are_scaled_into_the_bases_own_limits():
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1", max_linear=0.5, max_angular=10.0))
+        robot.current_pose()
+        robot.command(0.8, 0.4)  # 0.8 m/s and 8 rad/s on the base: 0.5 m/s caps both by 5/8
+        twist, _ = base.next()
+        assert twist.linear.x == pytest.approx(0.5) and twist.angular.z == pytest.approx(5.0)
+        assert robot.last_command == pytest.approx((0.5, 0.25))  # what was applied, in scenario units
+        base.stop_odometry()
+        robot.close()
+
+
+def test_a_command_that_is_not_a_number_is_sent_as_zero():
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1"))
+        robot.current_pose()
+        robot.command(math.nan, 0.3)
+        twist, _ = base.next()
+        assert (twist.linear.x, twist.angular.z) == (0.0, 0.0) and robot.counts()["non_finite_commands"] == 1
+        base.stop_odometry()
+        robot.close()
 
 
 def test_rmw_zenoh_commands_go_to_the_hashed_key_with_the_attachment():
@@ -132,10 +172,11 @@ def test_rmw_zenoh_commands_go_to_the_hashed_key_with_the_attachment():
         key = "0/robot1/cmd_vel/geometry_msgs::msg::dds_::TwistStamped_/" + STORE.hash_rihs01(typename)
         base = Base(base_session, key, typename)
         robot = robot_with_pose(driver, base, options)
-        assert robot.topics.pose_key == "0/robot1/odom/nav_msgs::msg::dds_::Odometry_/" + STORE.hash_rihs01(
+        assert robot.topics.odometry_key == "0/robot1/odom/nav_msgs::msg::dds_::Odometry_/" + STORE.hash_rihs01(
             "nav_msgs/msg/Odometry"
         )
         before = time.time_ns()
+        robot.current_pose()
         robot.command(0.2, 0.0)
         robot.command(0.3, 0.0)
         (first, first_attachment), (second, second_attachment) = base.next(), base.next()
@@ -153,23 +194,37 @@ def test_rmw_zenoh_commands_go_to_the_hashed_key_with_the_attachment():
         robot.close()
 
 
-def test_a_stale_pose_sends_zero_until_a_fresh_one_arrives():
+def test_stale_odometry_sends_zero_until_odometry_newer_than_the_stale_spell():
     options = Ros2Options(namespace="bot1", pose_timeout=0.2)
     with bus() as (driver, base_session):
         base = Base(base_session, "bot1/cmd_vel")
         robot = robot_with_pose(driver, base, options)
-        assert robot.pose_is_current()
+        assert robot.current_pose() is not None
         base.stop_odometry()
         time.sleep(0.3)
-        assert not robot.pose_is_current()
+        assert robot.current_pose() is None
         robot.command(1.0, 0.5)
         twist, _ = base.next()
         assert (twist.linear.x, twist.angular.z) == (0.0, 0.0) and robot.last_command == (0.0, 0.0)
         base.stream_odometry("bot1/odom", 1.0, 2.0, 0.5)
-        assert wait_until(robot.pose_is_current)
+        assert wait_until(lambda: robot.current_pose() is not None)
         robot.command(1.0, 0.0)
         twist, _ = base.next()
         assert twist.linear.x == pytest.approx(1.0)
+        assert robot.counts()["stale_spells"] == 1
+        base.stop_odometry()
+        robot.close()
+
+
+def test_a_step_acts_on_the_pose_it_read_even_if_a_newer_one_arrives_before_its_command():
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1"))
+        acting = robot.current_pose()
+        base.stop_odometry()
+        base.stream_odometry("bot1/odom", 3.0, 3.0, 0.0)  # the base moved meanwhile
+        assert wait_until(lambda: robot.pose()[0] == pytest.approx(60.0))
+        assert robot.command(0.0, 0.0) == pytest.approx(acting)  # the step's end, from the pose it acted on
         base.stop_odometry()
         robot.close()
 
@@ -186,11 +241,32 @@ def test_odometry_is_placed_by_the_map_from_odom_offset_and_the_origin():
         robot.close()
 
 
+def test_a_localiser_pose_corrects_map_from_odom_and_odometry_carries_it_on():
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = Ros2Robot(driver, Ros2Options(namespace="bot1", localiser_topic="amcl_pose"), SCENARIO, agent=0)
+        base.stream_odometry("bot1/odom", 1.0, 0.0, 0.0)
+        assert wait_until(lambda: robot.counts()["poses_received"] > 0)
+        assert not robot.has_pose()  # no map pose until the localiser speaks
+        assert wait_until(
+            lambda: (base.send_localiser_pose("bot1/amcl_pose", 2.0, 2.0, math.pi / 2), robot.has_pose())[1]
+        )
+        assert robot.pose() == pytest.approx((40.0, 40.0, math.pi / 2))
+        base.stop_odometry()
+        base.stream_odometry("bot1/odom", 2.0, 0.0, 0.0)  # 1 m ahead in odom: 1 m along map y
+        assert wait_until(lambda: robot.pose()[1] == pytest.approx(60.0))
+        assert robot.pose() == pytest.approx((40.0, 60.0, math.pi / 2))
+        base.stop_odometry()
+        robot.close()
+
+
 def test_a_payload_that_is_not_a_pose_is_rejected_and_counted():
     with bus() as (driver, base_session):
         robot = Ros2Robot(driver, Ros2Options(namespace="bot1"), SCENARIO, agent=0)
         assert wait_until(
-            lambda: (base_session.put("bot1/odom", b"\x00\x01\x00\x00 not odometry"), robot.poses_rejected)[1]
+            lambda: (base_session.put("bot1/odom", b"\x00\x01\x00\x00 not odometry"), robot.counts()["poses_rejected"])[
+                1
+            ]
         )
         assert not robot.has_pose()
         with pytest.raises(RuntimeError, match="no pose yet on bot1/odom"):
@@ -208,9 +284,27 @@ def test_waiting_for_a_pose_says_where_and_gives_up_when_stopped(caplog):
         robot.close()
 
 
-def test_a_crash_in_the_control_loop_still_sends_zero():
-    """agents.process.robot_of: however the agent's block ends, the base is sent zero before the
-    sessions close (here an exception, as a bug in the control loop would raise)."""
+def test_the_watchdog_stops_the_base_when_the_control_loop_falls_silent():
+    fast = Scenario(metres_per_unit=0.05, seconds_per_unit=0.05, dt=0.5)  # a command every 25 ms
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1"), scenario=fast)
+        robot.current_pose()
+        robot.command(0.5, 0.0)
+        moving, _ = base.next()
+        assert moving.linear.x == pytest.approx(0.5)
+        stopped, _ = base.next()  # nothing more from the loop: 3 periods on, the watchdog's zero
+        assert (stopped.linear.x, stopped.angular.z) == (0.0, 0.0)
+        assert robot.counts()["watchdog_stops"] == 1
+        time.sleep(0.2)
+        assert base.received.empty()  # one zero, not a stream of them
+        base.stop_odometry()
+        robot.close()
+
+
+def test_robot_of_sends_zero_however_its_block_ends():
+    """agents.process.robot_of, which the agent's whole run is inside: here an exception, as a bug in the
+    control loop would raise, is the end."""
     from agents.process import AgentOptions, robot_of
 
     with bus() as (driver, base_session):
@@ -219,6 +313,7 @@ def test_a_crash_in_the_control_loop_still_sends_zero():
             with robot_of(driver, SCENARIO, AgentOptions("t", 0), Ros2Options(namespace="bot1")) as robot:
                 base.stream_odometry("bot1/odom", 1.0, 2.0, 0.5)
                 assert wait_until(robot.has_pose)
+                robot.current_pose()
                 robot.command(0.7, 0.0)
                 raise RuntimeError("a bug in the control loop")
         base.stop_odometry()

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from agents.ros2.frames import ScenarioFrame, clamp, compose, yaw_of_quaternion
+from agents.ros2.frames import ScenarioFrame, compose, invert, scale_into, yaw_of_quaternion
 
 angles = st.floats(-math.pi + 1e-6, math.pi, allow_nan=False)
 coordinates = st.floats(-1e3, 1e3, allow_nan=False)
@@ -31,10 +31,19 @@ def test_compose_places_odometry_in_the_map_frame():
 
 
 @given(coordinates, coordinates, angles, coordinates, coordinates, angles)
-def test_compose_with_the_identity_changes_nothing_and_wraps_the_heading(ox, oy, ot, x, y, t):
+def test_compose_adds_headings_and_inverts(ox, oy, ot, x, y, t):
     assert compose((0.0, 0.0, 0.0), (x, y, t)) == pytest.approx((x, y, t), abs=1e-9)
     heading = compose((ox, oy, ot), (x, y, t))[2]
-    assert -math.pi <= heading <= math.pi
+    assert math.cos(heading - (ot + t)) == pytest.approx(1.0, abs=1e-9)  # ot + t, wrapped
+    offset = (ox, oy, ot)
+    assert compose(invert(offset), compose(offset, (x, y, t))) == pytest.approx((x, y, t), abs=1e-6)
+
+
+def test_a_localiser_pose_and_the_odometry_of_that_instant_give_map_from_odom():
+    odometry, map_pose = (1.0, 0.0, 0.0), (2.0, 2.0, math.pi / 2)
+    offset = compose(map_pose, invert(odometry))
+    assert offset == pytest.approx((2.0, 1.0, math.pi / 2))
+    assert compose(offset, odometry) == pytest.approx(map_pose)
 
 
 @given(coordinates, coordinates)
@@ -48,7 +57,17 @@ def test_velocities_scale_by_the_units():
     frame = ScenarioFrame(metres_per_unit=0.05, seconds_per_unit=0.1)
     # 1 unit per time unit is 0.05 m per 0.1 s; 1 rad per time unit is 10 rad/s.
     assert frame.to_ros_velocity(1.0, 1.0) == pytest.approx((0.5, 10.0))
+    assert frame.to_scenario_velocity(0.5, 10.0) == pytest.approx((1.0, 1.0))
 
 
-def test_clamp_is_symmetric():
-    assert clamp(3.0, 2.0) == 2.0 and clamp(-3.0, 2.0) == -2.0 and clamp(1.5, 2.0) == 1.5
+speeds = st.floats(-100, 100, allow_nan=False)
+
+
+@given(speeds, speeds)
+def test_scaling_into_bounds_keeps_the_curvature_and_the_bounds(v, omega):
+    scaled_v, scaled_omega = scale_into(v, omega, 1.0, math.pi)
+    assert abs(scaled_v) <= 1.0 + 1e-12 and abs(scaled_omega) <= math.pi + 1e-12
+    assert scaled_v * omega == pytest.approx(scaled_omega * v, abs=1e-9)  # same ω / v
+    if abs(v) <= 1.0 and abs(omega) <= math.pi:
+        assert (scaled_v, scaled_omega) == (v, omega)
+    assert scale_into(4.0, 1.0, 2.0, math.inf) == (2.0, 0.5)

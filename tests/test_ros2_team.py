@@ -53,7 +53,7 @@ def test_three_agents_drive_three_ros2_bases_to_complete_coverage(tmp_path):
         assert len(commands) >= summary["steps"] - 5  # one Twist a step reached the base
         assert (commands[-1]["v"], commands[-1]["omega"]) == (0.0, 0.0)  # left standing still
         counts = json.loads((out / "logs" / f"agent-{agent}.counts.json").read_text())
-        assert counts["rejected"] == 0
+        assert counts["rejected"] == 0 and counts["robot"]["poses_rejected"] == 0
 
 
 # ------------------------------------------------------------------ faults

@@ -39,7 +39,9 @@ def test_topic_names_resolve_as_ros_2_does(namespace, topic, name):
 
 def test_bridge_route_keys_and_no_attachment():
     topics = Ros2Topics.of(Ros2Options(namespace="bot1"))
-    assert (topics.command_key, topics.pose_key) == ("bot1/cmd_vel", "bot1/odom")
+    assert (topics.command_key, topics.odometry_key, topics.localiser_key) == ("bot1/cmd_vel", "bot1/odom", None)
+    localised = Ros2Topics.of(Ros2Options(namespace="bot1", localiser_topic="amcl_pose"))
+    assert localised.localiser_key == "bot1/amcl_pose"
     assert topics.attachment(1) is None
 
 
@@ -47,7 +49,12 @@ def test_rmw_zenoh_keys_carry_domain_type_name_and_hash():
     topics = Ros2Topics.of(Ros2Options(namespace="robot1", transport="rmw-zenoh", domain_id=0))
     # The key rmw_zenoh's design document gives for /robot1/cmd_vel (docs/design.md, "Topic key expressions").
     assert topics.command_key == f"0/robot1/cmd_vel/{TWIST_KEY_TAIL}"
-    assert topics.pose_key.startswith("0/robot1/odom/nav_msgs::msg::dds_::Odometry_/RIHS01_")
+    assert topics.odometry_key.startswith("0/robot1/odom/nav_msgs::msg::dds_::Odometry_/RIHS01_")
+    localised = Ros2Topics.of(Ros2Options(namespace="robot1", transport="rmw-zenoh", localiser_topic="amcl_pose"))
+    assert localised.localiser_key is not None
+    assert localised.localiser_key.startswith(
+        "0/robot1/amcl_pose/geometry_msgs::msg::dds_::PoseWithCovarianceStamped_/RIHS01_"
+    )
     stamped = Ros2Topics.of(Ros2Options(namespace="b", transport="rmw-zenoh", domain_id=7, stamped=True))
     assert stamped.command_key.startswith("7/b/cmd_vel/geometry_msgs::msg::dds_::TwistStamped_/RIHS01_")
 

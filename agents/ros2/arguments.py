@@ -5,29 +5,16 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from agents.ros2.options import Ros2Options
 
 ROBOTS = ("sim", "ros2")
-FLAGS = (
-    "--ros-namespace",
-    "--ros-transport",
-    "--ros-cmd-topic",
-    "--ros-stamped",
-    "--ros-frame-id",
-    "--ros-pose-topic",
-    "--ros-pose-type",
-    "--ros-odom-offset",
-    "--ros-origin",
-    "--ros-pose-timeout",
-    "--ros-max-linear",
-    "--ros-max-angular",
-    "--ros-domain",
-    "--ros-distro",
-    "--ros-connect",
-)
+NAME_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+"""One token of a ROS 2 name (REP 144 / rcl's validation): a letter or underscore, then letters, digits,
+underscores. Also what keeps Zenoh's wildcards (*, **, $*) out of the keys the driver publishes on."""
 
 
 def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
@@ -38,7 +25,7 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
         help="sim: the simulated unicycle (default); ros2: a ROS 2 base over Zenoh (deploy/ros2.md)",
     )
     ros = parser.add_argument_group("ROS 2 base (--robot ros2)")
-    ros.add_argument("--ros-namespace", default="", help="the base's namespace, e.g. bot1 (launcher: bot{id})")
+    ros.add_argument("--ros-namespace", default="", help="the base's namespace, e.g. bot1 (launcher: bot<id>)")
     ros.add_argument(
         "--ros-transport",
         choices=("bridge", "rmw-zenoh"),
@@ -48,19 +35,18 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
     ros.add_argument("--ros-cmd-topic", default="cmd_vel", help="velocity command topic (default cmd_vel)")
     ros.add_argument("--ros-stamped", action="store_true", help="send TwistStamped instead of Twist")
     ros.add_argument("--ros-frame-id", default="base_link", help="TwistStamped header frame (default base_link)")
+    ros.add_argument("--ros-odom-topic", default="odom", help="nav_msgs/Odometry topic (default odom)")
     ros.add_argument(
-        "--ros-pose-type",
-        choices=("odometry", "pose"),
-        default="odometry",
-        help="odometry: nav_msgs/Odometry (default); pose: PoseWithCovarianceStamped (e.g. amcl_pose)",
+        "--ros-localiser-topic",
+        metavar="TOPIC",
+        help="PoseWithCovarianceStamped in the map frame (e.g. amcl_pose) that corrects map <- odom",
     )
-    ros.add_argument("--ros-pose-topic", help="pose topic (default odom, or amcl_pose with --ros-pose-type pose)")
     ros.add_argument(
         "--ros-odom-offset",
         type=float,
         nargs=3,
         metavar=("X", "Y", "YAW_DEG"),
-        help="fixed map <- odom transform (metres, degrees) when the pose is odometry (default 0 0 0)",
+        help="fixed map <- odom transform (metres, degrees) without a localiser (default 0 0 0)",
     )
     ros.add_argument(
         "--ros-origin",
@@ -73,7 +59,7 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
         "--ros-pose-timeout",
         type=float,
         default=0.5,
-        help="seconds without a pose before the robot is stopped (default 0.5)",
+        help="seconds without odometry before the robot is stopped (default 0.5)",
     )
     ros.add_argument("--ros-max-linear", type=float, help="the base's speed limit, m/s")
     ros.add_argument("--ros-max-angular", type=float, help="the base's turn-rate limit, rad/s")
@@ -95,6 +81,21 @@ class RobotArgumentError(ValueError):
     """A --robot / --ros-* flag that cannot be used; the message names it."""
 
 
+def check_name(flag: str, name: str, namespace: bool = False) -> None:
+    """A ROS 2 namespace or topic name: tokens joined by '/', a leading '/' allowed (absolute), no
+    private '~' names and no Zenoh wildcards (a namespace '*' would drive every robot)."""
+    tokens = name.strip("/").split("/") if name.strip("/") else []
+    if (
+        (not tokens and not namespace)
+        or any(not NAME_TOKEN.fullmatch(token) for token in tokens)
+        or name.endswith("//")
+    ):
+        raise RobotArgumentError(
+            f"{flag}: expected a ROS 2 {'namespace' if namespace else 'topic name'} (letters, digits and '_' "
+            f"in tokens joined by '/', each token not starting with a digit), got {name!r}"
+        )
+
+
 def ros2_options_from(args: argparse.Namespace) -> Ros2Options:
     from agents.ros2.options import Ros2Options
 
@@ -105,22 +106,34 @@ def ros2_options_from(args: argparse.Namespace) -> Ros2Options:
     ):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise RobotArgumentError(f"{flag}: expected a positive number, got {value}")
-    if args.ros_domain is not None and not 0 <= args.ros_domain <= 232:
+    if not 0 <= args.ros_domain <= 232:
         raise RobotArgumentError(f"--ros-domain: expected a ROS domain id from 0 to 232, got {args.ros_domain}")
+    check_name("--ros-namespace", args.ros_namespace, namespace=True)
+    for flag, topic in (
+        ("--ros-cmd-topic", args.ros_cmd_topic),
+        ("--ros-odom-topic", args.ros_odom_topic),
+        ("--ros-localiser-topic", args.ros_localiser_topic),
+    ):
+        if topic is not None:
+            check_name(flag, topic)
+    if args.ros_transport == "rmw-zenoh" and args.ros_distro == "humble":
+        raise RobotArgumentError(
+            "--ros-distro humble with --ros-transport rmw-zenoh: humble's messages have no RIHS01 type hash (REP 2011 came "
+            "after it), which rmw_zenoh's keys carry from jazzy on; use the bridge"
+        )
     offset = args.ros_odom_offset or (0.0, 0.0, 0.0)
-    if args.ros_odom_offset and args.ros_pose_type == "pose":
-        raise RobotArgumentError("--ros-odom-offset: a PoseWithCovarianceStamped is already in the map frame")
+    if args.ros_odom_offset and args.ros_localiser_topic:
+        raise RobotArgumentError("--ros-odom-offset: with --ros-localiser-topic the localiser gives map <- odom")
     if not all(math.isfinite(value) for value in (*offset, *(args.ros_origin or ()))):
         raise RobotArgumentError("--ros-odom-offset / --ros-origin: expected finite numbers")
-    pose_topic = args.ros_pose_topic or ("amcl_pose" if args.ros_pose_type == "pose" else "odom")
     return Ros2Options(
         namespace=args.ros_namespace,
         transport=args.ros_transport,
         command_topic=args.ros_cmd_topic,
         stamped=args.ros_stamped,
         frame_id=args.ros_frame_id,
-        pose_topic=pose_topic,
-        pose_type=args.ros_pose_type,
+        odometry_topic=args.ros_odom_topic,
+        localiser_topic=args.ros_localiser_topic,
         odom_offset=(offset[0], offset[1], math.radians(offset[2])),
         pose_timeout=args.ros_pose_timeout,
         max_linear=args.ros_max_linear or math.inf,

@@ -1,16 +1,26 @@
 """The ROS 2 base behind an agent: :class:`Ros2Robot` implements :class:`agents.robot.Robot` over Zenoh.
 
-It publishes velocity commands on the base's command topic and keeps the latest pose read from its
-odometry or localisation topic (callback thread, under a lock). What it does for a real base's sake:
+It publishes velocity commands on the base's command topic and keeps the latest odometry (callback
+thread, under a lock); with a localiser (``localiser_topic``, e.g. AMCL's ``amcl_pose``) each of its
+poses corrects the map ← odom transform, as ROS's own map → odom tf does, otherwise that transform is
+the fixed ``odom_offset``. Odometry is what tells whether the pose is fresh: a localiser publishes only
+when its filter updates (AMCL: after 0.2 m or 0.5 rad of motion by default), so a robot standing still
+would never hear from it. What the driver does for a real base's sake:
 
-- every command is clamped to the scenario's bounds (|v| ≤ k_v, |ω| ≤ π k_ω: eq. 6, 12) and then to the
-  robot's own (``max_linear`` m/s, ``max_angular`` rad/s);
-- a pose older than ``pose_timeout`` seconds is stale: the robot is sent zero, the agent holds its step
-  (:meth:`pose_is_current` is False) and says so, until a pose that arrived after that moment;
-- :meth:`stop` sends zero; the agent process calls it when its loop ends for any reason (end of run,
-  Ctrl-C, SIGTERM, an exception) before the session closes. A lost router cannot carry that zero: the
-  base's own command timeout stops it then, as every ROS base has one, and the stale pose keeps the
-  agent from moving it again before fresh odometry comes through the router.
+- the pose a step acts on is read once, with its freshness, under the lock (:meth:`current_pose`), and
+  the same pose gives the step's predicted end (:meth:`command`): a pose arriving in between cannot
+  pair an old position with a new verdict;
+- every command is scaled, v and ω by one factor so the path keeps its curvature, into the paper's
+  bounds (|v| ≤ k_v, |ω| ≤ π k_ω: eq. 15–16) and the base's (``max_linear`` m/s, ``max_angular``
+  rad/s); a command that is not a finite number is sent as zero;
+- odometry older than ``pose_timeout`` seconds is stale: :meth:`current_pose` is None, the robot is
+  sent zero and the agent holds its step and says so, until odometry that arrived after that moment;
+- a watchdog thread sends zero when the control loop has sent nothing for ``WATCHDOG_PERIODS`` control
+  periods (a blocking recovery query, a pause): the base does not roll on the last command meanwhile;
+- :meth:`stop` sends zero (reliably, at once); the agent process calls it when its loop ends for any
+  reason (end of run, Ctrl-C, SIGTERM, SIGHUP, an exception) before the sessions close. A lost router
+  cannot carry that zero: the base's own command timeout must stop it then (deploy/ros2.md's checklist),
+  and the stale odometry keeps the agent from moving it again before fresh odometry comes through.
 """
 
 from __future__ import annotations
@@ -19,13 +29,14 @@ import logging
 import math
 import threading
 import time
-from typing import Any
+from collections import deque
+from collections.abc import Callable
 
 import zenoh
 
-from agents.ros2.frames import Pose, ScenarioFrame, clamp, compose
-from agents.ros2.messages import BadRosMessage, decode_pose, encode_velocity
-from agents.ros2.options import Ros2Options
+from agents.ros2.frames import Pose, ScenarioFrame, compose, invert, scale_into
+from agents.ros2.messages import BadRosMessage, RosPose, decode_pose, encode_velocity
+from agents.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, Ros2Options
 from agents.ros2.transport import Ros2Topics
 from model.dynamics import unicycle_step
 from model.scenario import Scenario
@@ -35,6 +46,10 @@ log = logging.getLogger("anicov.ros2")
 
 WAIT_LOG_PERIOD = 2.0
 """Seconds between the 'waiting for a pose' lines while the agent waits for its robot."""
+WATCHDOG_PERIODS = 3
+"""Control periods without a command after which the watchdog sends zero."""
+ODOMETRY_HISTORY = 256
+"""Odometry poses kept to pair a localiser's pose with the odometry of the same instant (8 s at 30 Hz)."""
 
 
 def frame_of(scenario: Scenario, options: Ros2Options) -> ScenarioFrame:
@@ -49,155 +64,207 @@ def frame_of(scenario: Scenario, options: Ros2Options) -> ScenarioFrame:
 class Ros2Robot:
     """A ROS 2 base commanded over Zenoh; poses and commands in scenario units (see :mod:`.frames`)."""
 
-    def __init__(
-        self,
-        session: zenoh.Session,
-        options: Ros2Options,
-        scenario: Scenario,
-        agent: int,
-    ) -> None:
+    def __init__(self, session: zenoh.Session, options: Ros2Options, scenario: Scenario, agent: int) -> None:
         self.options, self.agent = options, agent
         self.frame = frame_of(scenario, options)
-        self._max_speed, self._max_turn_rate = scenario.k_v, math.pi * scenario.k_omega  # eq. 15-16's bounds
+        self._bounds = (scenario.k_v, math.pi * scenario.k_omega)  # eq. 15–16, scenario units
         self._dt = scenario.dt
+        self._period = scenario.dt * scenario.seconds_per_unit  # wall seconds of one control step
         self.topics = Ros2Topics.of(options)
-        self._publisher = session.declare_publisher(self.topics.command_key)
-        self._lock = threading.Lock()
-        self._map_pose: Pose | None = None
-        self._received_at = -math.inf  # monotonic seconds of the latest pose
-        self._stale_since: float | None = None  # the pose went stale then; only a later one is fresh
-        self.poses_received = 0
-        self.poses_rejected = 0
-        self.commands_sent = 0
+        self._session = session
+        self._publisher = session.declare_publisher(
+            self.topics.command_key, priority=zenoh.Priority.REAL_TIME, express=True
+        )
+        self._lock = threading.Lock()  # the callbacks' state below
+        self._odometry: Pose | None = None  # odom frame, metres
+        self._received_at = -math.inf  # monotonic seconds of the latest odometry
+        self._history: deque[tuple[int, Pose]] = deque(maxlen=ODOMETRY_HISTORY)  # (stamp ns, odom pose)
+        self._offset: Pose | None = None if options.localiser_topic else options.odom_offset  # map ← odom
+        self._stale_since: float | None = None  # control thread only: the odometry went stale then
+        self._acting: Pose | None = None  # control thread only: the pose this step acts on (None: hold)
+        self._send_lock = threading.Lock()  # the control loop and the watchdog both send
+        self._last_sent_at = math.inf  # monotonic seconds of the latest command (inf: none yet)
+        self._moving = False  # the latest command sent was not zero
+        self.counters = {"poses_received": 0, "poses_rejected": 0, "localiser_poses": 0, "commands_sent": 0}
+        self.counters |= {"stale_spells": 0, "watchdog_stops": 0, "non_finite_commands": 0}
         self.last_command: tuple[float, float] = (0.0, 0.0)  # applied, scenario units
-        self._subscriber = session.declare_subscriber(self.topics.pose_key, self._on_pose)
+        self._subscribers = [session.declare_subscriber(self.topics.odometry_key, self._on_odometry)]
+        if self.topics.localiser_key:
+            self._subscribers.append(session.declare_subscriber(self.topics.localiser_key, self._on_localiser))
+        self._closing = threading.Event()
+        self._watchdog = threading.Thread(target=self._watch, name=f"ros2-watchdog-{agent}", daemon=True)
+        self._watchdog.start()
 
-    # ------------------------------------------------------------ pose
+    # ------------------------------------------------------------ messages in (Zenoh's threads)
 
-    def _on_pose(self, sample: zenoh.Sample) -> None:
+    def _decode(self, sample: zenoh.Sample, typename: str) -> RosPose | None:
         try:
-            read = decode_pose(sample.payload.to_bytes(), self.options.pose_typename, self.options.distribution)
+            return decode_pose(sample.payload.to_bytes(), typename, self.options.distribution)
         except BadRosMessage as error:
             with self._lock:
-                self.poses_rejected += 1
-                first = self.poses_rejected == 1
-            if first or self.poses_rejected % 100 == 0:
+                self.counters["poses_rejected"] += 1
+                rejected = self.counters["poses_rejected"]
+            if rejected == 1 or rejected % 100 == 0:
                 log.warning(
-                    "agent %d: rejected a pose on %s (%d so far): %s",
-                    self.agent,
-                    sample.key_expr,
-                    self.poses_rejected,
-                    error,
+                    "agent %d: rejected a pose on %s (%d so far): %s", self.agent, sample.key_expr, rejected, error
                 )
+            return None
+
+    def _on_odometry(self, sample: zenoh.Sample) -> None:
+        read = self._decode(sample, ODOMETRY)
+        if read is None:
             return
-        pose = read.pose if self.options.pose_type == "pose" else compose(self.options.odom_offset, read.pose)
         with self._lock:
-            self._map_pose = pose
+            self._odometry = read.pose
             self._received_at = time.monotonic()
-            self.poses_received += 1
+            self._history.append((read.stamp_ns, read.pose))
+            self.counters["poses_received"] += 1
+
+    def _on_localiser(self, sample: zenoh.Sample) -> None:
+        """A map-frame pose: map ← odom = pose ⊕ (odometry of the same instant)⁻¹."""
+        read = self._decode(sample, POSE_WITH_COVARIANCE)
+        if read is None:
+            return
+        with self._lock:
+            if not self._history:
+                return  # no odometry yet to pair it with
+            _, odometry = min(self._history, key=lambda entry: abs(entry[0] - read.stamp_ns))
+            self._offset = compose(read.pose, invert(odometry))
+            self.counters["localiser_poses"] += 1
+
+    # ------------------------------------------------------------ pose (the control thread)
+
+    def _snapshot(self) -> tuple[Pose | None, float]:
+        """The latest map-frame pose (None until odometry and the map ← odom transform are both known)
+        and when its odometry arrived, read together."""
+        with self._lock:
+            if self._odometry is None or self._offset is None:
+                return None, -math.inf
+            return compose(self._offset, self._odometry), self._received_at
 
     def pose(self) -> Pose:
-        with self._lock:
-            map_pose = self._map_pose
+        """The latest pose, fresh or not (hellos, held steps)."""
+        map_pose, _ = self._snapshot()
         if map_pose is None:
-            raise RuntimeError(f"agent {self.agent}: no pose yet on {self.topics.pose_key}")
+            raise RuntimeError(f"agent {self.agent}: no pose yet on {self.topics.odometry_key}")
         return self.frame.to_scenario(map_pose)
 
     def has_pose(self) -> bool:
-        with self._lock:
-            return self._map_pose is not None
+        return self._snapshot()[0] is not None
 
-    def pose_is_current(self) -> bool:
-        """The latest pose is younger than ``pose_timeout`` and, after a stale spell, arrived after it began."""
+    def current_pose(self) -> Pose | None:
+        """The pose this step acts on, or None while the odometry is stale: older than ``pose_timeout``,
+        or, after a stale spell, not newer than its start. Says when the robot stops and moves again."""
+        map_pose, received = self._snapshot()
         now = time.monotonic()
-        with self._lock:
-            received = self._received_at
-        if self._stale_since is None:
-            if now - received <= self.options.pose_timeout:
-                return True
+        fresh = map_pose is not None and now - received <= self.options.pose_timeout
+        if fresh and self._stale_since is not None:
+            fresh = received > self._stale_since
+            if fresh:
+                log.warning(
+                    "agent %d: a fresh pose on %s after %.2f s: the robot moves again",
+                    self.agent, self.topics.odometry_key, now - self._stale_since,
+                )  # fmt: skip
+                self._stale_since = None
+        elif not fresh and self._stale_since is None:
             self._stale_since = now
+            self.counters["stale_spells"] += 1
             log.warning(
                 "agent %d: no pose on %s for %.2f s: the robot is stopped until a fresh one arrives",
-                self.agent,
-                self.topics.pose_key,
-                now - received,
-            )
-            return False
-        if received > self._stale_since and now - received <= self.options.pose_timeout:
-            log.warning(
-                "agent %d: a fresh pose on %s after %.2f s: the robot moves again",
-                self.agent,
-                self.topics.pose_key,
-                now - self._stale_since,
-            )
-            self._stale_since = None
-            return True
-        return False
+                self.agent, self.topics.odometry_key, now - received,
+            )  # fmt: skip
+        self._acting = self.frame.to_scenario(map_pose) if fresh and map_pose is not None else None
+        return self._acting
 
-    def wait_for_pose(self, stopped: Any, give_up: Any) -> bool:
-        """Block until a first pose arrives, saying where it waits; False if ``stopped()`` or ``give_up()``."""
+    def wait_for_pose(self, stopped: Callable[[], bool], give_up: Callable[[], bool]) -> bool:
+        """Block until a first pose can be formed, saying where it waits; False if ``stopped()`` or
+        ``give_up()`` first."""
         next_line = time.monotonic()
         while not self.has_pose():
             if stopped() or give_up():
                 return False
             if time.monotonic() >= next_line:
-                log.info(
-                    "agent %d waits for its robot's pose: %s on Zenoh key %s (%s)",
-                    self.agent,
-                    self.options.pose_typename,
-                    self.topics.pose_key,
-                    self.options.transport,
-                )
+                log.info("agent %d waits for its robot's pose: %s", self.agent, self.topics.describe_pose())
                 next_line = time.monotonic() + WAIT_LOG_PERIOD
             time.sleep(0.02)
-        log.info("agent %d: robot pose %s from %s", self.agent, _rounded(self.pose()), self.topics.pose_key)
+        log.info("agent %d: robot pose %s from %s", self.agent, _rounded(self.pose()), self.topics.odometry_key)
         return True
 
     # ------------------------------------------------------------ commands
 
     def command(self, v: float, omega: float) -> Pose:
-        """Send (v, ω) (scenario units, clamped; zero while the pose is stale); return the pose the base
-        reaches in one period if it follows (eq. 1), for teammates until its next odometry."""
-        if not self.pose_is_current():
-            v, omega = 0.0, 0.0
-        v, omega = clamp(v, self._max_speed), clamp(omega, self._max_turn_rate)
-        linear, angular = self.frame.to_ros_velocity(v, omega)
-        linear, angular = clamp(linear, self.options.max_linear), clamp(angular, self.options.max_angular)
+        """Send (v, ω) (scenario units, scaled into the bounds; zero unless this step's
+        :meth:`current_pose` was fresh); return where the base gets in one period if it follows (eq. 1)
+        from that same pose, for teammates until its next odometry."""
+        acting = self._acting
+        if not (math.isfinite(v) and math.isfinite(omega)):
+            self.counters["non_finite_commands"] += 1
+            log.error("agent %d: the law gave a command that is not a number (%r, %r): sent zero", self.agent, v, omega)
+            v = omega = 0.0
+        if acting is None:
+            v = omega = 0.0
+        v, omega = scale_into(v, omega, *self._bounds)
+        linear, angular = scale_into(
+            *self.frame.to_ros_velocity(v, omega), self.options.max_linear, self.options.max_angular
+        )
         self._send(linear, angular)
-        scale = self.frame.metres_per_unit / self.frame.seconds_per_unit
-        self.last_command = (linear / scale, angular * self.frame.seconds_per_unit)
-        return unicycle_step(*self.pose(), *self.last_command, self._dt)
+        self.last_command = self.frame.to_scenario_velocity(linear, angular)
+        return unicycle_step(*(acting or self.pose()), *self.last_command, self._dt)
 
     def stop(self) -> None:
-        """Zero velocity, now."""
-        self._send(0.0, 0.0)
+        """Zero velocity, now, and not dropped on a congested link."""
+        self._send(0.0, 0.0, reliably=True)
         self.last_command = (0.0, 0.0)
 
-    def _send(self, linear: float, angular: float) -> None:
+    def _send(self, linear: float, angular: float, reliably: bool = False) -> None:
+        with self._send_lock:
+            self._send_locked(linear, angular, reliably)
+
+    def _send_locked(self, linear: float, angular: float, reliably: bool) -> None:
         payload = encode_velocity(
             linear, angular, self.options.stamped, time.time_ns(), self.options.frame_id, self.options.distribution
         )
-        self.commands_sent += 1
-        attachment = self.topics.attachment(self.commands_sent)
-        if attachment is None:
-            self._publisher.put(payload)
+        self.counters["commands_sent"] += 1
+        attachment = self.topics.attachment(self.counters["commands_sent"])
+        if reliably:
+            self._session.put(
+                self.topics.command_key,
+                payload,
+                attachment=attachment,
+                congestion_control=zenoh.CongestionControl.BLOCK,
+                priority=zenoh.Priority.REAL_TIME,
+                express=True,
+            )
         else:
             self._publisher.put(payload, attachment=attachment)
+        self._last_sent_at = time.monotonic()
+        self._moving = (linear, angular) != (0.0, 0.0)
+
+    def _watch(self) -> None:
+        """Zero to the base when the control loop has been silent for WATCHDOG_PERIODS periods while the
+        base moves; checked and sent under the send lock, so it never lands after a newer command."""
+        silence = WATCHDOG_PERIODS * self._period
+        while not self._closing.wait(self._period):
+            with self._send_lock:
+                quiet = time.monotonic() - self._last_sent_at
+                if quiet > silence and self._moving:
+                    self.counters["watchdog_stops"] += 1
+                    log.warning("agent %d: no command for %.2f s: the watchdog stops the robot", self.agent, quiet)
+                    self._send_locked(0.0, 0.0, reliably=True)
 
     def close(self) -> None:
         """Stop the base and leave the bus."""
+        self._closing.set()
         try:
             self.stop()
         finally:
-            self._subscriber.undeclare()
+            self._watchdog.join(timeout=1.0)
+            for subscriber in self._subscribers:
+                subscriber.undeclare()
             self._publisher.undeclare()
 
     def counts(self) -> dict[str, int]:
-        return {
-            "poses_received": self.poses_received,
-            "poses_rejected": self.poses_rejected,
-            "commands_sent": self.commands_sent,
-        }
+        return dict(self.counters)
 
 
 def _rounded(pose: Pose) -> tuple[float, float, float]:

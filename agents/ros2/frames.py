@@ -50,7 +50,25 @@ class ScenarioFrame:
         """(v, ω) in scenario units per time unit as (m/s, rad/s)."""
         return v * self.metres_per_unit / self.seconds_per_unit, omega / self.seconds_per_unit
 
+    def to_scenario_velocity(self, linear: float, angular: float) -> tuple[float, float]:
+        """(m/s, rad/s) in scenario units per time unit: the inverse of :meth:`to_ros_velocity`."""
+        return linear * self.seconds_per_unit / self.metres_per_unit, angular * self.seconds_per_unit
 
-def clamp(value: float, limit: float) -> float:
-    """``value`` in [−limit, limit]."""
-    return max(-limit, min(limit, value))
+
+def invert(pose: Pose) -> Pose:
+    """The inverse transform: ``compose(invert(p), p)`` is the identity."""
+    x, y, theta = pose
+    c, s = math.cos(theta), math.sin(theta)
+    return -c * x - s * y, s * x - c * y, -theta
+
+
+def scale_into(v: float, omega: float, max_v: float, max_omega: float) -> tuple[float, float]:
+    """(v, ω) scaled by one factor in [0, 1] until |v| ≤ max_v and |ω| ≤ max_omega: the path keeps its
+    curvature ω / v, and a command the safety filter let through stays inside its constraints (each
+    holds at zero and is convex, so it holds on the segment between zero and the command)."""
+    factor = 1.0
+    if abs(v) > max_v:
+        factor = max_v / abs(v)
+    if abs(omega) > max_omega:
+        factor = min(factor, max_omega / abs(omega))
+    return v * factor, omega * factor

@@ -14,7 +14,6 @@ TWIST = "geometry_msgs/msg/Twist"
 TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
 ODOMETRY = "nav_msgs/msg/Odometry"
 POSE_WITH_COVARIANCE = "geometry_msgs/msg/PoseWithCovarianceStamped"
-POSE_TYPES = {"odometry": ODOMETRY, "pose": POSE_WITH_COVARIANCE}
 
 
 @dataclass(frozen=True)
@@ -26,9 +25,9 @@ class Ros2Options:
     command_topic: str = "cmd_vel"
     stamped: bool = False  # TwistStamped (newer Nav2 bases) instead of Twist
     frame_id: str = "base_link"  # TwistStamped's header frame
-    pose_topic: str = "odom"
-    pose_type: str = "odometry"  # "odometry" (nav_msgs/Odometry) or "pose" (PoseWithCovarianceStamped)
-    odom_offset: Pose = (0.0, 0.0, 0.0)  # map ← odom (x, y metres, θ radians), when the pose is odometry
+    odometry_topic: str = "odom"  # nav_msgs/Odometry: motion, and whether the pose is fresh
+    localiser_topic: str | None = None  # PoseWithCovarianceStamped in the map frame (e.g. amcl_pose)
+    odom_offset: Pose = (0.0, 0.0, 0.0)  # map ← odom (x, y metres, θ radians) without a localiser
     pose_timeout: float = 0.5
     max_linear: float = math.inf
     max_angular: float = math.inf
@@ -36,10 +35,6 @@ class Ros2Options:
     distribution: str = "jazzy"
     connect: tuple[str, ...] = ()  # endpoints of the robot's bridge or router, if not the team's bus
     origin: tuple[float, float] | None = None  # map-frame (x, y) of the scenario's (0, 0); None: see frame_of
-
-    @property
-    def pose_typename(self) -> str:
-        return POSE_TYPES[self.pose_type]
 
     @property
     def command_typename(self) -> str:

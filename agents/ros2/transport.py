@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import zenoh.ext
 
 from agents.ros2.messages import dds_type_name, type_hash
+from agents.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE
 
 if TYPE_CHECKING:
     from agents.ros2.options import Ros2Options
@@ -65,33 +66,45 @@ def publisher_gid(key: str, salt: str) -> bytes:
 
 @dataclass(frozen=True)
 class Ros2Topics:
-    """The keys of one base's command and pose topics on Zenoh, and what goes with each command."""
+    """The keys of one base's topics on Zenoh (command, odometry, the localiser's pose if any), and what
+    goes with each command."""
 
     transport: str
     command_key: str
-    pose_key: str
+    odometry_key: str
+    localiser_key: str | None = None
     gid: bytes = b""
 
     @staticmethod
     def of(options: Ros2Options) -> Ros2Topics:
-        if options.transport == "bridge":
-            return Ros2Topics(
-                "bridge",
-                bridge_key(options.namespace, options.command_topic),
-                bridge_key(options.namespace, options.pose_topic),
-            )
-        if options.transport != "rmw-zenoh":
+        if options.transport not in TRANSPORTS:
             raise ValueError(f"--ros-transport: expected one of {', '.join(TRANSPORTS)}, got {options.transport!r}")
-        command = rmw_zenoh_key(
-            options.domain_id, options.namespace, options.command_topic, options.command_typename, options.distribution
-        )
-        pose = rmw_zenoh_key(
-            options.domain_id, options.namespace, options.pose_topic, options.pose_typename, options.distribution
-        )
-        return Ros2Topics("rmw-zenoh", command, pose, publisher_gid(command, f"{time.time_ns()}"))
+        topics = [
+            (options.command_topic, options.command_typename),
+            (options.odometry_topic, ODOMETRY),
+            (options.localiser_topic, POSE_WITH_COVARIANCE),
+        ]
+        if options.transport == "bridge":
+            keys = [bridge_key(options.namespace, topic) if topic else None for topic, _ in topics]
+            return Ros2Topics("bridge", keys[0] or "", keys[1] or "", keys[2])
+        keys = [
+            rmw_zenoh_key(options.domain_id, options.namespace, topic, typename, options.distribution)
+            if topic
+            else None
+            for topic, typename in topics
+        ]
+        gid = publisher_gid(keys[0] or "", f"{time.time_ns()}")
+        return Ros2Topics("rmw-zenoh", keys[0] or "", keys[1] or "", keys[2], gid)
 
     def attachment(self, sequence: int) -> bytes | None:
         """What the ``sequence``-th command carries besides its payload (None: nothing)."""
         if self.transport == "bridge":
             return None
         return rmw_zenoh_attachment(sequence, time.time_ns(), self.gid)
+
+    def describe_pose(self) -> str:
+        """Where the pose comes from, for the 'waiting for a pose' line."""
+        text = f"{ODOMETRY} on Zenoh key {self.odometry_key}"
+        if self.localiser_key:
+            text += f" and {POSE_WITH_COVARIANCE} on {self.localiser_key}"
+        return f"{text} ({self.transport})"
