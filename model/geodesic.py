@@ -5,11 +5,13 @@
 - The distance field of an objective: Dijkstra (scipy.sparse.csgraph) over the passable cells,
   8-connected, a step costing ``cell`` straight and √2·``cell`` diagonally; a diagonal step is allowed
   only when both cells beside it are passable (no cutting a wall's corner). Unreachable: +inf.
-- The way to follow it (:func:`descent_waypoint`): from the robot's cell, walk down the field to the
-  lowest neighbour the graph connects (no corner cutting), up to ``lookahead`` cells, and aim at the
-  farthest cell of that walk that a straight drive reaches with the disk free all the way (else the
-  robot's own cell centre; the walk's cells are tried from the farthest); the distance is the field at the robot's cell plus the way to that cell's
-  centre. When a straight drive reaches the objective itself, aim at it, at its straight distance,
+- The way to follow it (:func:`descent_waypoint`): from the robot's entry cell (its own, or, when that
+  one is not passable, as for a robot held inside the planning margin, the best cell in sight beside
+  it: :func:`entry_cell`), walk down the field to the lowest neighbour the graph connects (no corner
+  cutting), up to ``lookahead`` cells, and aim at the farthest cell of that walk that a straight drive
+  reaches with the disk free all the way (else the entry cell's centre; the walk's cells are tried from
+  the farthest); the distance is the field at the entry cell plus the way to its centre. When a
+  straight drive reaches the objective itself, aim at it, at its straight distance,
   exactly as the paper's eq. 10–11 do in an empty domain.
 """
 
@@ -114,9 +116,8 @@ def descent_waypoint(
     if in_sight(occupied, x, y, objective_x, objective_y, cell, radius, bounded):
         return math.hypot(objective_x - x, objective_y - y), objective_x, objective_y
     rows, cols = field.shape
-    row = min(max(math.floor(y / cell), 0), rows - 1)
-    col = min(max(math.floor(x / cell), 0), cols - 1)
-    if not math.isfinite(field[row, col]):
+    row, col = entry_cell(field, occupied, x, y, cell, radius, bounded)
+    if row < 0:
         return math.hypot(objective_x - x, objective_y - y), objective_x, objective_y  # cut off: head straight
     waypoint_x, waypoint_y = (col + 0.5) * cell, (row + 0.5) * cell
     walk = np.empty((lookahead, 2), dtype=np.int64)
@@ -142,7 +143,7 @@ def descent_waypoint(
         if in_sight(occupied, x, y, centre_x, centre_y, cell, radius, bounded):
             waypoint_x, waypoint_y = centre_x, centre_y
             break
-    return length_by_field(field, x, y, cell), waypoint_x, waypoint_y
+    return length_by_field(field, occupied, x, y, cell, radius, bounded), waypoint_x, waypoint_y
 
 
 @njit(cache=True)
@@ -163,13 +164,47 @@ def path_length(
     cell's centre (:func:`length_by_field`, as :func:`descent_waypoint` measures it); +inf when the goal cannot be reached."""
     if in_sight(occupied, x, y, goal_x, goal_y, cell, radius, bounded):
         return straight
-    return length_by_field(field, x, y, cell)
+    return length_by_field(field, occupied, x, y, cell, radius, bounded)
 
 
 @njit(cache=True)
-def length_by_field(field: np.ndarray, x: float, y: float, cell: float) -> float:
-    """The field at the cell of (x, y) plus the way from (x, y) to that cell's centre."""
+def length_by_field(
+    field: np.ndarray, occupied: np.ndarray, x: float, y: float, cell: float, radius: float, bounded: bool
+) -> float:
+    """The field at the entry cell of (x, y) (:func:`entry_cell`) plus the way from (x, y) to its centre;
+    +inf if there is none."""
+    row, col = entry_cell(field, occupied, x, y, cell, radius, bounded)
+    if row < 0:
+        return math.inf
+    return field[row, col] + math.hypot((col + 0.5) * cell - x, (row + 0.5) * cell - y)
+
+
+ENTRY_RINGS = 2
+"""How many rings of cells around a robot's own are searched for a way onto the graph (see entry_cell)."""
+
+
+@njit(cache=True)
+def entry_cell(
+    field: np.ndarray, occupied: np.ndarray, x: float, y: float, cell: float, radius: float, bounded: bool
+) -> tuple[int, int]:
+    """Where the robot at (x, y) joins the graph of passable cells: its own cell when the field is finite
+    there; else, within ENTRY_RINGS rings, the cell in sight (:func:`in_sight`, which allows a robot
+    inside the planning margin to drive on) with the least field plus way to its centre; (−1, −1) if
+    none. A robot the safety filter holds s off a wall stands inside the planning margin r + s (+5 % of
+    a cell), so its own cell may not be passable: the field there is +inf, and heading straight at the
+    objective from there drove it into the wall for ever (issue 12's stalls on the maps)."""
     rows, cols = field.shape
     row = min(max(math.floor(y / cell), 0), rows - 1)
     col = min(max(math.floor(x / cell), 0), cols - 1)
-    return field[row, col] + math.hypot((col + 0.5) * cell - x, (row + 0.5) * cell - y)
+    if math.isfinite(field[row, col]):
+        return row, col
+    best, best_row, best_col = math.inf, -1, -1
+    for r in range(max(row - ENTRY_RINGS, 0), min(row + ENTRY_RINGS + 1, rows)):
+        for c in range(max(col - ENTRY_RINGS, 0), min(col + ENTRY_RINGS + 1, cols)):
+            if not math.isfinite(field[r, c]):
+                continue
+            centre_x, centre_y = (c + 0.5) * cell, (r + 0.5) * cell
+            total = field[r, c] + math.hypot(centre_x - x, centre_y - y)
+            if total < best and in_sight(occupied, x, y, centre_x, centre_y, cell, radius, bounded):
+                best, best_row, best_col = total, r, c
+    return best_row, best_col

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from model.clearance import disk_is_free, step_or_stay
-from model.geodesic import descent_waypoint, distance_fields, passable_cells
+from model.geodesic import descent_waypoint, distance_fields, entry_cell, length_by_field, passable_cells
 
 
 def wall_with_a_gap() -> np.ndarray:
@@ -75,3 +75,21 @@ def test_following_the_waypoints_gets_round_the_wall_where_heading_straight_stal
 
     assert drive(aim_at_waypoints=False) > 10.0  # pressed against the wall
     assert drive(aim_at_waypoints=True) < 1.0
+
+
+def test_a_robot_inside_the_planning_margin_joins_the_graph_beside_it_instead_of_heading_straight():
+    """A robot the safety filter holds s off a wall stands inside the planning margin, in a cell the
+    graph leaves out: it follows the field from the best cell beside it (issue 12's stalls on the maps),
+    where the field at its own cell (+inf) once sent it straight at the objective, into the wall."""
+    occupied, planning_radius = wall_with_a_gap(), 0.75
+    goal = (30.5, 5.5)
+    passable = passable_cells(occupied, planning_radius, 1.0, True)
+    field = distance_fields(passable, [(5, 30)], 1.0)[0]
+    x, y = 19.3, 5.5  # 0.7 from the wall (r + s): its cell's centre is 0.5 off it, not passable
+    assert math.isinf(field[5, 19])
+    row, col = entry_cell(field, occupied, x, y, 1.0, planning_radius, True)
+    assert (row, col) != (-1, -1) and math.isfinite(field[row, col]) and abs(col - 19) <= 2
+    distance, _, waypoint_y = descent_waypoint(field, passable, occupied, x, y, *goal, 1.0, 20, 0.75, True)
+    assert math.isfinite(distance) and distance > 2 * (32 - 5)  # round the wall's end, not through it
+    assert waypoint_y > y  # up, toward the gap: not at the goal behind the wall
+    assert length_by_field(field, occupied, x, y, 1.0, planning_radius, True) == distance
