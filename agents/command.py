@@ -7,9 +7,13 @@ only when the command runs.
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from agents.ros2.arguments import RobotArgumentError, add_robot_arguments
 from model.scenario import Scenario, ScenarioError
+
+if TYPE_CHECKING:
+    from agents.ros2.options import Ros2Options
 from runtime.arguments import add_process_arguments, scenario_from_arguments
 
 
@@ -36,7 +40,7 @@ def main(args: argparse.Namespace) -> int:
     return run_agent(scenario, options, config_from_arguments(args), stop, ros2)
 
 
-def ros2_options(args: argparse.Namespace, scenario: Scenario):
+def ros2_options(args: argparse.Namespace, scenario: Scenario) -> Ros2Options:
     """The ROS 2 driver's options, once the extra is installed and the clock is the robot's own."""
     from agents.ros2 import require_rosbags
     from agents.ros2.arguments import ros2_options_from

@@ -78,9 +78,15 @@ class RosTeam:
     the coordinator, agent 0 driving the base (--ros-connect to the robot's router) and agent 1 on a
     simulated unicycle, so that the run goes on while agent 0 is away."""
 
-    def __init__(self, tmp_path: Path, stack: ExitStack) -> None:
+    def __init__(self, tmp_path: Path, stack: ExitStack, secure: bool = False) -> None:
         self.dir, self.stack = tmp_path, stack
         self.team, self.router_port, self.robot_port = unique_team(), free_port(), free_port()
+        self.profile = None
+        if secure:  # the team's bus as deploy/README.md's secure profile has it; the robot's side as before
+            from anicov.secure import make_profile
+
+            endpoint = f"tls/127.0.0.1:{self.router_port}"
+            self.profile = make_profile(tmp_path / "secure", agents=2, team=self.team, endpoint=endpoint)
         self.base_log = tmp_path / "base.jsonl"
         # Four times the paper's area: the run lasts long past the faults below.
         self.config = write_toml(
@@ -98,24 +104,27 @@ class RosTeam:
         self.processes[name] = process
         return process
 
-    def router(self, name: str, port: int) -> None:
-        self.start(name, [sys.executable, "-m", "anicov.cli", "router", "--listen", f"tcp/127.0.0.1:{port}"])
+    def router(self, name: str, port: int, secure: bool = False) -> None:
+        where = ["--zenoh-config", str(self.profile.config("router"))] if secure and self.profile else []
+        where = where or ["--listen", f"tcp/127.0.0.1:{port}"]
+        self.start(name, [sys.executable, "-m", "anicov.cli", "router", *where])
 
-    def team_flags(self) -> list[str]:
-        return [
-            "--team", self.team, "--config", str(self.config), "--clock", "realtime", "--speed", "20",
-            "--connect", f"tcp/127.0.0.1:{self.router_port}",
-        ]  # fmt: skip
+    def team_flags(self, role: str) -> list[str]:
+        flags = ["--team", self.team, "--config", str(self.config), "--clock", "realtime", "--speed", "20"]
+        if self.profile:
+            return [*flags, "--zenoh-config", str(self.profile.config(role))]
+        return [*flags, "--connect", f"tcp/127.0.0.1:{self.router_port}"]
 
     def agent(self, name: str = "agent-0") -> subprocess.Popen:
         ros = ["--robot", "ros2", "--ros-namespace", "bot0", "--ros-connect", f"tcp/127.0.0.1:{self.robot_port}"]
-        return self.start(name, [sys.executable, "-m", "anicov.cli", "agent", "--id", "0", *self.team_flags(), *ros])
+        command = [sys.executable, "-m", "anicov.cli", "agent", "--id", "0", *self.team_flags("agent-0"), *ros]
+        return self.start(name, command)
 
     def launch(self) -> None:
         from model.parameters import starting_poses
         from model.scenario import load_scenario
 
-        self.router("router", self.router_port)
+        self.router("router", self.router_port, secure=True)
         self.router("robot-router", self.robot_port)
         x, y, theta = starting_poses(load_scenario(self.config))[0]
         pose = [repr(float(x * 0.05)), repr(float(y * 0.05)), repr(float(theta * 180 / 3.141592653589793))]
@@ -125,8 +134,10 @@ class RosTeam:
              "--pose", *pose, "--log", str(self.base_log)],
         )  # fmt: skip
         cli = [sys.executable, "-m", "anicov.cli"]
-        self.start("coordinator", [*cli, "coordinator", *self.team_flags(), "--out", str(self.dir / "run")])
-        self.start("agent-1", [*cli, "agent", "--id", "1", *self.team_flags()])
+        self.start(
+            "coordinator", [*cli, "coordinator", *self.team_flags("coordinator"), "--out", str(self.dir / "run")]
+        )
+        self.start("agent-1", [*cli, "agent", "--id", "1", *self.team_flags("agent-1")])
         self.agent()
         assert self.wait_until_moving(after=0.0, timeout=90), (self.dir / "agent-0.log").read_text()
 
@@ -144,11 +155,20 @@ class RosTeam:
 
 
 @contextmanager
-def ros_team(tmp_path: Path) -> Iterator[RosTeam]:
+def ros_team(tmp_path: Path, secure: bool = False) -> Iterator[RosTeam]:
     with ExitStack() as stack:
-        team = RosTeam(tmp_path, stack)
+        team = RosTeam(tmp_path, stack, secure)
         team.launch()
         yield team
+
+
+def test_a_ros2_agent_in_a_secure_team_reaches_its_base_on_the_robots_own_bridge(tmp_path):
+    """deploy/ros2.md's layout: the team's bus under the secure profile as today (mutual TLS, access
+    control: agent-0 may publish only its own keys), the robot's topics on the robot's own router."""
+    with ros_team(tmp_path, secure=True) as team:
+        assert team.wait_until_moving(after=0.0, timeout=10)
+        assert agent_log_time(tmp_path / "agent-0.log", "agent 0 starts (realtime clock)") is not None
+        assert "tls/" in (tmp_path / "secure" / "agent-0.json5").read_text()
 
 
 def test_sigterm_of_the_agent_sends_zero_and_sigkill_leaves_the_base_to_its_own_timeout(tmp_path):

@@ -106,7 +106,9 @@ class Base:
             position=T["geometry_msgs/msg/Point"](x=x, y=y, z=0.0),
             orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=math.sin(theta / 2), w=math.cos(theta / 2)),
         )
-        twist = T["geometry_msgs/msg/Twist"](linear=vector(x=self.v, y=0.0, z=0.0), angular=vector(x=0.0, y=0.0, z=self.omega))
+        twist = T["geometry_msgs/msg/Twist"](
+            linear=vector(x=self.v, y=0.0, z=0.0), angular=vector(x=0.0, y=0.0, z=self.omega)
+        )
         message = T["nav_msgs/msg/Odometry"](
             header=header,
             child_frame_id="base_link",
