@@ -45,6 +45,21 @@ class RunLog:
             self.final_poses[state.agent] = state.next_pose
             self.last_step[state.agent] = state.step
 
+    def _end_row(self, trace: np.ndarray, steps: int, agent: int, pose: tuple[float, float, float]) -> None:
+        """An agent's last row: where its last step heard took it, at that step's end, so the row follows
+        from the one before by eq. 1. In lockstep every agent's last step is ``steps`` − 1 and the row is
+        ``steps``, as the engine's. Realtime, an agent a step or two behind the coordinator's count ends
+        earlier (it may have stepped on, unheard); one ahead of it ends at ``steps`` with the pose its
+        state of that step started from. An agent heard only saying hello has no row."""
+        last = self.last_step[agent]
+        if last < 0:
+            return  # only its hello was heard: it never stepped, it has no trajectory
+        if last + 1 <= steps:
+            trace[last + 1, agent, :3] = pose
+        else:
+            trace[steps, agent, :3] = self.rows[steps][agent, :3] if steps in self.rows else np.nan
+        trace[min(last + 1, steps), agent, 3:] = 0.0
+
     def take_snapshot(self, time_now: float, lack: np.ndarray) -> None:
         self.snapshot_times.append(time_now)
         self.snapshots.append(quantised_lack(lack))
@@ -58,8 +73,7 @@ class RunLog:
             if step < steps:
                 trace[step] = row
         for agent, pose in self.final_poses.items():
-            trace[steps, agent, :3] = pose
-            trace[steps, agent, 3:] = 0.0
+            self._end_row(trace, steps, agent, pose)
         flags = np.zeros((steps, self.agents), dtype=np.uint8)
         for step, row in self.safety.items():
             if step < steps:

@@ -113,3 +113,19 @@ def test_the_run_log_leaves_nan_where_a_state_was_never_heard():
     result = node.result(1, completed=False, completion_step=1)
     assert not np.isnan(result.trace[0, 0]).any()
     assert np.isnan(result.trace[0, 1]).all()
+
+
+def test_each_agents_last_row_is_where_its_last_heard_step_took_it_so_rows_follow_by_eq_1():
+    """Realtime: agent 1's last state heard is of step 0 while the run ends after 3 steps; its last row
+    is its pose at t_1 (the end of step 0), not at t_3 (issue 13: a final row one step's travel off)."""
+    from coordinator.run_log import RunLog
+
+    log = RunLog(agents=2)
+    pose = (1.0, 1.0, 0.0)
+    for step in range(4):  # agent 0: one step ahead of the run's 3
+        log.record(AgentState(0, step, (1.0 + step, 1.0, 0.0), 1.0, 0.0, 0.0, (2.0 + step, 1.0, 0.0)))
+    log.record(AgentState(1, 0, pose, 1.0, 0.0, 0.0, (2.0, 1.0, 0.0)))
+    trace = log.result(SCENARIO, 3, completed=True, completion_step=3, final_lack=np.zeros((1, 1))).trace
+    assert tuple(trace[1, 1, :3]) == (2.0, 1.0, 0.0) and tuple(trace[1, 1, 3:5]) == (0.0, 0.0)
+    assert np.isnan(trace[2:, 1]).all()
+    assert tuple(trace[3, 0, :3]) == (4.0, 1.0, 0.0)  # its state of step 3 started there, as step 2 ended
