@@ -121,10 +121,27 @@ def robot_with_pose(
     return robot
 
 
-def test_commands_are_twists_in_metres_and_radians_scaled_into_the_papers_bounds():
+@contextmanager
+def robot_on_a_base(
+    options: Ros2Options = Ros2Options(namespace="bot1"),  # noqa: B008 (frozen: one default is safe)
+    pose=(1.0, 2.0, 0.5),
+    scenario: Scenario = SCENARIO,
+    command_key: str = "bot1/cmd_vel",
+    typename: str = "geometry_msgs/msg/Twist",
+) -> Iterator[tuple[Ros2Robot, Base]]:
+    """A driver with its pose from a base streaming odometry; closed (a zero sent) at the end."""
     with bus() as (driver, base_session):
-        base = Base(base_session, "bot1/cmd_vel")
-        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1"))
+        base = Base(base_session, command_key, typename)
+        robot = robot_with_pose(driver, base, options, pose, scenario)
+        try:
+            yield robot, base
+        finally:
+            base.stop_odometry()
+            robot.close()
+
+
+def test_commands_are_twists_in_metres_and_radians_scaled_into_the_papers_bounds():
+    with robot_on_a_base() as (robot, base):
         assert robot.current_pose() == pytest.approx((20.0, 40.0, 0.5))  # (1 m, 2 m) in units of 0.05 m
         robot.command(0.4, 0.1)
         twist, attachment = base.next()
@@ -134,35 +151,26 @@ def test_commands_are_twists_in_metres_and_radians_scaled_into_the_papers_bounds
         twist, _ = base.next()
         assert twist.linear.x == pytest.approx(1.0) and twist.angular.z == pytest.approx(-5 / 3 / 0.05)
         assert robot.last_command == pytest.approx((1.0, -5 / 3))
-        base.stop_odometry()
-        robot.close()
+        robot.stop()  # what close() sends first, at the end of every run
         twist, _ = base.next()
-        assert (twist.linear.x, twist.angular.z) == (0.0, 0.0)
+        assert (twist.linear.x, twist.angular.z) == (0.0, 0.0) and robot.last_command == (0.0, 0.0)
 
 
 def test_commands_are_scaled_into_the_bases_own_limits():
-    with bus() as (driver, base_session):
-        base = Base(base_session, "bot1/cmd_vel")
-        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1", max_linear=0.5, max_angular=10.0))
+    with robot_on_a_base(Ros2Options(namespace="bot1", max_linear=0.5, max_angular=10.0)) as (robot, base):
         robot.current_pose()
         robot.command(0.8, 0.4)  # 0.8 m/s and 8 rad/s on the base: 0.5 m/s caps both by 5/8
         twist, _ = base.next()
         assert twist.linear.x == pytest.approx(0.5) and twist.angular.z == pytest.approx(5.0)
         assert robot.last_command == pytest.approx((0.5, 0.25))  # what was applied, in scenario units
-        base.stop_odometry()
-        robot.close()
 
 
 def test_a_command_that_is_not_a_number_is_sent_as_zero():
-    with bus() as (driver, base_session):
-        base = Base(base_session, "bot1/cmd_vel")
-        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1"))
+    with robot_on_a_base() as (robot, base):
         robot.current_pose()
         robot.command(math.nan, 0.3)
         twist, _ = base.next()
         assert (twist.linear.x, twist.angular.z) == (0.0, 0.0) and robot.counts()["non_finite_commands"] == 1
-        base.stop_odometry()
-        robot.close()
 
 
 def test_rmw_zenoh_commands_go_to_the_hashed_key_with_the_attachment():
@@ -196,9 +204,7 @@ def test_rmw_zenoh_commands_go_to_the_hashed_key_with_the_attachment():
 
 def test_stale_odometry_sends_zero_until_odometry_newer_than_the_stale_spell():
     options = Ros2Options(namespace="bot1", pose_timeout=0.2)
-    with bus() as (driver, base_session):
-        base = Base(base_session, "bot1/cmd_vel")
-        robot = robot_with_pose(driver, base, options)
+    with robot_on_a_base(options) as (robot, base):
         assert robot.current_pose() is not None
         base.stop_odometry()
         time.sleep(0.3)
@@ -212,33 +218,23 @@ def test_stale_odometry_sends_zero_until_odometry_newer_than_the_stale_spell():
         twist, _ = base.next()
         assert twist.linear.x == pytest.approx(1.0)
         assert robot.counts()["stale_spells"] == 1
-        base.stop_odometry()
-        robot.close()
 
 
 def test_a_step_acts_on_the_pose_it_read_even_if_a_newer_one_arrives_before_its_command():
-    with bus() as (driver, base_session):
-        base = Base(base_session, "bot1/cmd_vel")
-        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1"))
+    with robot_on_a_base() as (robot, base):
         acting = robot.current_pose()
         base.stop_odometry()
         base.stream_odometry("bot1/odom", 3.0, 3.0, 0.0)  # the base moved meanwhile
         assert wait_until(lambda: robot.pose()[0] == pytest.approx(60.0))
         assert robot.command(0.0, 0.0) == pytest.approx(acting)  # the step's end, from the pose it acted on
-        base.stop_odometry()
-        robot.close()
 
 
 def test_odometry_is_placed_by_the_map_from_odom_offset_and_the_origin():
     offset = (2.0, 1.0, math.pi / 2)
     options = Ros2Options(namespace="bot1", odom_offset=offset, origin=(-1.0, 0.0))
-    with bus() as (driver, base_session):
-        base = Base(base_session, "bot1/cmd_vel")
-        robot = robot_with_pose(driver, base, options, pose=(1.0, 0.0, 0.0))
+    with robot_on_a_base(options, pose=(1.0, 0.0, 0.0)) as (robot, _):
         # odom (1, 0, 0) is map (2, 2, π/2); the scenario's (0, 0) is map (−1, 0); units of 0.05 m.
         assert robot.pose() == pytest.approx((60.0, 40.0, math.pi / 2))
-        base.stop_odometry()
-        robot.close()
 
 
 def test_a_localiser_pose_corrects_map_from_odom_and_odometry_carries_it_on():
@@ -286,9 +282,7 @@ def test_waiting_for_a_pose_says_where_and_gives_up_when_stopped(caplog):
 
 def test_the_watchdog_stops_the_base_when_the_control_loop_falls_silent():
     fast = Scenario(metres_per_unit=0.05, seconds_per_unit=0.05, dt=0.5)  # a command every 25 ms
-    with bus() as (driver, base_session):
-        base = Base(base_session, "bot1/cmd_vel")
-        robot = robot_with_pose(driver, base, Ros2Options(namespace="bot1"), scenario=fast)
+    with robot_on_a_base(Ros2Options(namespace="bot1"), scenario=fast) as (robot, base):
         robot.current_pose()
         robot.command(0.5, 0.0)
         moving, _ = base.next()
@@ -298,8 +292,6 @@ def test_the_watchdog_stops_the_base_when_the_control_loop_falls_silent():
         assert robot.counts()["watchdog_stops"] == 1
         time.sleep(0.2)
         assert base.received.empty()  # one zero, not a stream of them
-        base.stop_odometry()
-        robot.close()
 
 
 def test_robot_of_sends_zero_however_its_block_ends():
