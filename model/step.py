@@ -15,6 +15,7 @@ from model.clearance import disk_is_free, step_or_stay
 from model.control import combined_law, global_law, local_law
 from model.dynamics import unicycle_step
 from model.ground import Ground
+from model.occlusion import teammates_in_view
 from model.sensing import sense_wedge
 from model.wall_law import global_law_among_walls
 
@@ -101,6 +102,7 @@ def decide_and_sense(
             law.literal_heading,
             ground,
             field,
+            teammates_in_view(ground, positions, me, x, y, law.sensing_range),
         )
     v, omega = combined_law(
         theta, e_omega, u_loc, theta_loc, u_glo, theta_glo, law.beta, law.k_v, law.k_omega, law.literal_omega
