@@ -9,12 +9,12 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from agents.ros2.arguments import RobotArgumentError, add_robot_arguments
+from agents.ros2.arguments import add_robot_arguments
 from model.scenario import Scenario, ScenarioError
+from runtime.arguments import add_process_arguments, scenario_from_arguments
 
 if TYPE_CHECKING:
     from agents.ros2.options import Ros2Options
-from runtime.arguments import add_process_arguments, scenario_from_arguments
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,17 +43,8 @@ def main(args: argparse.Namespace) -> int:
 def ros2_options(args: argparse.Namespace, scenario: Scenario) -> Ros2Options:
     """The ROS 2 driver's options, once the extra is installed and the clock is the robot's own."""
     from agents.ros2 import require_rosbags
-    from agents.ros2.arguments import ros2_options_from
+    from agents.ros2.arguments import check_real_time, ros2_options_from
 
     require_rosbags()
-    if args.clock != "realtime":
-        raise RobotArgumentError(
-            "--robot ros2 drives a real base, which cannot wait for a lockstep go: use --clock realtime"
-        )
-    real_time = 1.0 / scenario.seconds_per_unit
-    if abs(args.speed - real_time) > 1e-9 * real_time:
-        raise RobotArgumentError(
-            f"--speed: a real base moves in real time: expected --speed {real_time:g} (1 / the scenario's "
-            f"seconds_per_unit {scenario.seconds_per_unit:g}), got {args.speed:g}"
-        )
+    check_real_time(args.clock, args.speed, scenario.seconds_per_unit)
     return ros2_options_from(args)

@@ -56,15 +56,12 @@ def check_ros2_team(args: argparse.Namespace, scenario: Scenario, speed_given: b
             "--test-bases: the stand-in bases are not members of a --secure team (no certificate); with a "
             "secure profile, bases are reached on the robot's own bridge (deploy/ros2.md)"
         )
+    from agents.ros2.arguments import check_real_time, real_time_speed
+
     args.clock = args.clock or "realtime"
-    if args.clock != "realtime":
-        raise ScenarioError("--robot ros2: a real base cannot wait for a lockstep go; use --clock realtime")
-    real_time = 1.0 / scenario.seconds_per_unit
-    if speed_given and not math.isclose(args.speed, real_time, rel_tol=1e-9):
-        raise ScenarioError(
-            f"--speed: a real base moves in real time: expected {real_time:g} (1 / seconds_per_unit), got {args.speed:g}"
-        )
-    args.speed = real_time
+    if not speed_given:
+        args.speed = real_time_speed(scenario.seconds_per_unit)
+    check_real_time(args.clock, args.speed, scenario.seconds_per_unit)
 
 
 def ros2_agent_flags(args: argparse.Namespace, agent: int) -> list[str]:

@@ -120,6 +120,7 @@ def descent_waypoint(
     if row < 0:
         return math.hypot(objective_x - x, objective_y - y), objective_x, objective_y  # cut off: head straight
     waypoint_x, waypoint_y = (col + 0.5) * cell, (row + 0.5) * cell
+    distance = field[row, col] + math.hypot(waypoint_x - x, waypoint_y - y)  # as length_by_field measures it
     walk = np.empty((lookahead, 2), dtype=np.int64)
     steps = 0
     for _ in range(lookahead):
@@ -143,7 +144,7 @@ def descent_waypoint(
         if in_sight(occupied, x, y, centre_x, centre_y, cell, radius, bounded):
             waypoint_x, waypoint_y = centre_x, centre_y
             break
-    return length_by_field(field, occupied, x, y, cell, radius, bounded), waypoint_x, waypoint_y
+    return distance, waypoint_x, waypoint_y
 
 
 @njit(cache=True)

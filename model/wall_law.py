@@ -28,7 +28,7 @@ from numba import njit
 from model.control import global_law_around_walls
 from model.geodesic import descent_waypoint
 from model.ground import Ground
-from model.visibility import hidden_by_teammates, segment_crosses_occupied
+from model.visibility import line_of_sight
 
 
 @njit(cache=True)
@@ -119,6 +119,6 @@ def uncovered_to_look_at(
 def _in_clear_sight(
     ground: Ground, teammates: np.ndarray, x: float, y: float, target_x: float, target_y: float, cell: float
 ) -> bool:
-    if segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell):
-        return False
-    return not (ground.occlusion and hidden_by_teammates(teammates, ground.radius, x, y, target_x, target_y))
+    """The camera's rule (model.visibility.line_of_sight), teammates' disks only with occlusion."""
+    hiding = teammates if ground.occlusion else teammates[:0]
+    return line_of_sight(ground.occupied, x, y, target_x, target_y, cell, hiding, ground.radius)

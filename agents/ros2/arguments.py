@@ -81,6 +81,26 @@ class RobotArgumentError(ValueError):
     """A --robot / --ros-* flag that cannot be used; the message names it."""
 
 
+def real_time_speed(seconds_per_unit: float) -> float:
+    """The --speed at which the realtime clock runs with a real base: one scenario time unit per
+    ``seconds_per_unit`` wall seconds."""
+    return 1.0 / seconds_per_unit
+
+
+def check_real_time(clock: str, speed: float, seconds_per_unit: float) -> None:
+    """A real base moves in real time: the realtime clock at :func:`real_time_speed`, else the flag."""
+    if clock != "realtime":
+        raise RobotArgumentError(
+            "--robot ros2 drives a real base, which cannot wait for a lockstep go: use --clock realtime"
+        )
+    expected = real_time_speed(seconds_per_unit)
+    if not math.isclose(speed, expected, rel_tol=1e-9):
+        raise RobotArgumentError(
+            f"--speed: a real base moves in real time: expected --speed {expected:g} (1 / the scenario's "
+            f"seconds_per_unit {seconds_per_unit:g}), got {speed:g}"
+        )
+
+
 def check_name(flag: str, name: str, namespace: bool = False) -> None:
     """A ROS 2 namespace or topic name: tokens joined by '/', a leading '/' allowed (absolute), no
     private '~' names and no Zenoh wildcards (a namespace '*' would drive every robot)."""
