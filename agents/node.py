@@ -15,7 +15,7 @@ from agents.robot import Robot, SimulatedUnicycle
 from model.coverage_map import load_kernels as load_map_kernels
 from model.ground import NO_FIELD
 from model.parameters import law_parameters, safety_parameters, starting_poses
-from model.safety import PARKED, POSE_STALE, RAN_LATE, TEAMMATE, filter_command
+from model.safety import MEMORY_SIZE, PARKED, POSE_STALE, RAN_LATE, TEAMMATE, filter_command
 from model.safety import load_kernels as load_safety_kernels
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, load_kernels
@@ -59,7 +59,7 @@ class AgentNode:
         self.heard_at = np.full(scenario.agents, time.monotonic())
         self.kinds = np.full(scenario.agents, TEAMMATE, dtype=np.int64)  # PARKED once a teammate's process is gone
         self.safety = safety_parameters(scenario)
-        self.safety_memory = np.zeros(2, dtype=np.int64)  # the filter's deadlock state (model.safety)
+        self.safety_memory = np.zeros(MEMORY_SIZE, dtype=np.int64)  # the filter's deadlock state (model.safety)
         self.robot = robot or SimulatedUnicycle(tuple(starts[options.agent]), self.law, self.ground)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=1000 + options.agent)
         self.step = 0

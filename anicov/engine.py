@@ -24,7 +24,7 @@ from model.ground import Ground, open_ground
 from model.parameters import coverage_map_of, law_parameters, safety_parameters, starting_poses
 from model.planning import Plan, Planner
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack, snapshot_steps
-from model.safety import SafetyParameters, filter_command
+from model.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move, sense_only
 from model.world import World, world_of
@@ -52,7 +52,7 @@ def advance_team(
     """Run up to ``steps`` steps of the paper's law for the whole team; stop early at full coverage.
 
     ``fields[i]``: the distance field of agent i's objective (terrain only). With ``safety`` enabled every
-    command passes through the filter (model.safety), from the poses at t_k, with ``memory`` (N, 2) its
+    command passes through the filter (model.safety), from the poses at t_k, with ``memory`` (N, MEMORY_SIZE) its
     deadlock state. Writes the per-step trace (TRACE_FIELDS), the filter's flags and e_D after each step;
     returns (steps done, uncovered cells, deficit ticks).
     """
@@ -105,7 +105,7 @@ def run_scenario(
     if scenario.controller == "zigzag":
         return _run_zigzag(scenario, coverage_map, poses, record_trace, progress)
     law, world = law_parameters(scenario, coverage_map), world_of(scenario)
-    safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, 2), dtype=np.int64)
+    safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     planner = Planner(scenario)
     block = scenario.replan_steps
     agents = scenario.agents

@@ -23,6 +23,7 @@ from model.parameters import coverage_map_of, initial_poses, law_parameters, saf
 from model.reachability import nearest_reachable
 from model.reference import numpy_team_step
 from model.run import TRACE_FIELDS
+from model.safety import MEMORY_SIZE
 from model.scenario import PAPER_SCENARIO, load_scenario
 from model.world import world_of
 
@@ -40,7 +41,7 @@ def engine_rate(agents: int, steps: int, scenario_path: Path = PAPER_SCENARIO, *
     errors = np.zeros(steps)
     flags = np.zeros((steps, agents), dtype=np.uint8)
     total = coverage_map.target_ticks * coverage_map.counted_cells
-    safety, memory = safety_parameters(scenario), np.zeros((agents, 2), dtype=np.int64)
+    safety, memory = safety_parameters(scenario), np.zeros((agents, MEMORY_SIZE), dtype=np.int64)
 
     def advance(coverage: np.ndarray, at: np.ndarray, count: int) -> int:
         done, _, _ = advance_team(

@@ -25,7 +25,14 @@ Agrawal & Sreenath (RSS 2017), with each robot taking half of each pair's constr
 Deadlock (a robot held still by a teammate for ``STUCK_STEPS`` steps): the standard remedy of a
 rotation bias (the "keep right" rule, Wang et al. 2017, Sec. VI; Grover et al. 2016): the nominal
 velocity is turned by ``KEEP_RIGHT`` to the robot's right until the law's own command passes the filter
-again (resolved) or ``DETOUR_STEPS`` have gone (given up; it may be found again).
+again (resolved) or ``DETOUR_STEPS`` have gone (given up; it may be found again). A rotation of a velocity
+near zero does nothing, and a robot held while it *turns in place* (its law asks the look-ahead point to
+move mostly by turning: |v̂| < l·|ω̂|, as near an objective, where eq. 10 stops it and turns it to look)
+asks for just that: two robots side by side turning toward the same blob swing their points at each
+other and stay frozen. There the priority rule settles it: the robot whose nearest teammate has the
+lower id yields, driving its point straight away from that teammate's at k_v for ``YIELD_STEPS`` steps,
+so the other can turn (the id order of Alg. 2's own tie-breaking; priority-based yielding as in
+Čáp, Novák, Kleiner & Selecký, IEEE T-ASE 12(3), 2015).
 """
 
 from __future__ import annotations
@@ -41,7 +48,7 @@ from model.geometry import wrap_angle
 from model.ground import Ground
 
 FILTER_CHANGED = 1  # the command differs from the law's
-KEEPING_RIGHT = 2  # a deadlock's detour is under way
+KEEPING_RIGHT = 2  # a deadlock's detour is under way (keeping right or yielding)
 NO_SAFE_COMMAND = 4  # the QP was empty: stopped
 STALE_NEIGHBOUR = 8  # a teammate in range sent no pose for max_pose_age: stopped
 DEADLOCK_FOUND = 16  # held by a teammate for STUCK_STEPS: the detour starts
@@ -58,6 +65,13 @@ WANTS_TO_MOVE = 0.05
 KEEP_RIGHT = math.radians(60.0)
 DETOUR_STEPS = 100
 """The most steps one detour lasts before it is given up."""
+YIELD_STEPS = 20
+"""Steps a robot yielding to a lower-id teammate drives away from it (2 time units at dt = 0.1)."""
+
+HELD, DETOUR, YIELDING = 0, 1, 2
+MEMORY_SIZE = 3
+"""A robot's deadlock state (``memory``): steps held so far, steps of the detour under way, and whether
+that detour is a yield (1) or keeping right (0)."""
 
 TEAMMATE, PARKED = 0, 1
 """How a teammate takes part: it filters too (half of each constraint each), or it no longer moves
@@ -244,13 +258,13 @@ def filter_command(
     """The command robot ``me`` applies, and what the filter did (the flag bits above).
 
     ``poses`` (N, 3): every robot's last known pose, this one's current; ``ages`` (N,): how old each is
-    (0 in lockstep); ``kinds``: TEAMMATE or PARKED; ``memory`` (2,): steps held so far and steps of the
-    detour under way, updated in place (the engine and the agent both keep it, so lockstep agrees)."""
+    (0 in lockstep); ``kinds``: TEAMMATE or PARKED; ``memory`` (MEMORY_SIZE,): the deadlock state, updated
+    in place (the engine and the agent both keep it, so lockstep agrees)."""
     v, omega, feasible, binding, stale, wall_x, wall_y = safe_velocities(
         v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
     )
     if stale:  # it depends on the poses alone, not on the command
-        memory[0] = 0
+        memory[HELD] = 0
         return 0.0, 0.0, STALE_NEIGHBOUR
     law_omega = omega_hat  # what FILTER_CHANGED compares with, also when the slide turns the nominal
     pressed = wall_x != 0.0 or wall_y != 0.0
@@ -261,31 +275,95 @@ def filter_command(
             v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
         )
     flags = 0
-    if memory[1] > 0:  # on a detour: back on the law's command once it passes the filter
-        if feasible and not _held(v_hat, omega_hat, v, omega, binding, safety):
-            memory[1] = 0
-            flags |= DEADLOCK_RESOLVED
-        elif memory[1] >= DETOUR_STEPS:
-            memory[1] = 0
+    if memory[DETOUR] > 0 and memory[YIELDING] == 1:  # yielding: away from the teammate, YIELD_STEPS in all
+        away_x, away_y = _yield_direction(me, poses, safety)
+        if memory[DETOUR] >= YIELD_STEPS or (away_x == 0.0 and away_y == 0.0):
+            memory[DETOUR] = memory[YIELDING] = 0
+            if feasible and not _held(v_hat, omega_hat, v, omega, binding, safety):
+                flags |= DEADLOCK_RESOLVED
         else:
-            memory[1] += 1
+            memory[DETOUR] += 1
+            flags |= KEEPING_RIGHT
+            v, omega, feasible = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
+    elif memory[DETOUR] > 0:  # keeping right: back on the law's command once it passes the filter
+        if feasible and not _held(v_hat, omega_hat, v, omega, binding, safety):
+            memory[DETOUR] = 0
+            flags |= DEADLOCK_RESOLVED
+        elif memory[DETOUR] >= DETOUR_STEPS:
+            memory[DETOUR] = 0
+        else:
+            memory[DETOUR] += 1
             flags |= KEEPING_RIGHT
             v, omega, feasible, _, _, _, _ = safe_velocities(
                 v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, -KEEP_RIGHT
             )
     elif binding and _held(v_hat, omega_hat, v if feasible else 0.0, omega if feasible else 0.0, binding, safety):
-        memory[0] += 1
-        if memory[0] >= STUCK_STEPS:
-            memory[0] = 0
-            memory[1] = 1
+        memory[HELD] += 1
+        if memory[HELD] >= STUCK_STEPS:
+            memory[HELD] = 0
+            memory[DETOUR] = 1
             flags |= DEADLOCK_FOUND
+            turning = abs(v_hat) < safety.lookahead * abs(omega_hat)
+            away_x, away_y = _yield_direction(me, poses, safety)
+            if turning and (away_x != 0.0 or away_y != 0.0):
+                memory[YIELDING] = 1
+                flags |= KEEPING_RIGHT
+                v, omega, feasible = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
     else:
-        memory[0] = 0
+        memory[HELD] = 0
     if not feasible:
         return 0.0, 0.0, flags | NO_SAFE_COMMAND
     if abs(v - v_hat) + safety.lookahead * abs(omega - law_omega) > 1e-12 * (1.0 + abs(v_hat)):
         flags |= FILTER_CHANGED
     return v, omega, flags
+
+
+@njit(cache=True)
+def _yield_direction(me: int, poses: np.ndarray, safety: SafetyParameters) -> tuple[float, float]:
+    """The unit vector from the nearest teammate's look-ahead point (within safety_range, centre to centre)
+    to this robot's, when that teammate has the lower id (this robot yields); else (0, 0)."""
+    ahead = safety.lookahead
+    x, y, theta = poses[me, 0], poses[me, 1], poses[me, 2]
+    px, py = x + ahead * math.cos(theta), y + ahead * math.sin(theta)
+    nearest, best, away_x, away_y = -1, math.inf, 0.0, 0.0
+    for j in range(poses.shape[0]):
+        if j == me or not math.isfinite(poses[j, 0]):
+            continue
+        if math.hypot(x - poses[j, 0], y - poses[j, 1]) > safety.reach:
+            continue
+        dx = px - poses[j, 0] - ahead * math.cos(poses[j, 2])
+        dy = py - poses[j, 1] - ahead * math.sin(poses[j, 2])
+        distance = math.hypot(dx, dy)
+        if distance < best:
+            nearest, best = j, distance
+            away_x, away_y = (dx / distance, dy / distance) if distance > 0.0 else (-math.cos(theta), -math.sin(theta))
+    if nearest < 0 or nearest > me:
+        return 0.0, 0.0
+    return away_x, away_y
+
+
+@njit(cache=True)
+def _drive_along(
+    away_x: float,
+    away_y: float,
+    me: int,
+    poses: np.ndarray,
+    ages: np.ndarray,
+    kinds: np.ndarray,
+    ground: Ground,
+    cell: float,
+    safety: SafetyParameters,
+) -> tuple[float, float, bool]:
+    """The safe command nearest moving the look-ahead point along (away_x, away_y) at k_v: the nominal
+    z = k_v·(n·e, n·e⊥) in the robot's frame, through the same QP."""
+    theta = poses[me, 2]
+    cos_t, sin_t = math.cos(theta), math.sin(theta)
+    v_hat = safety.v_max * (away_x * cos_t + away_y * sin_t)
+    omega_hat = safety.v_max * (-away_x * sin_t + away_y * cos_t) / safety.lookahead
+    v, omega, feasible, _, _, _, _ = safe_velocities(
+        v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
+    )
+    return v, omega, feasible
 
 
 SLIDE_AWAY = math.radians(20.0)
@@ -334,5 +412,5 @@ def load_kernels(safety: SafetyParameters, ground: Ground, cell: float, agents: 
         ground,
         cell,
         safety,
-        np.zeros(2, dtype=np.int64),
+        np.zeros(MEMORY_SIZE, dtype=np.int64),
     )

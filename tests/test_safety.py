@@ -16,6 +16,7 @@ from model.safety import (
     DEADLOCK_FOUND,
     DEADLOCK_RESOLVED,
     FILTER_CHANGED,
+    MEMORY_SIZE,
     PARKED,
     STALE_NEIGHBOUR,
     TEAMMATE,
@@ -43,7 +44,9 @@ def filtered(poses: np.ndarray, nominal: list[tuple[float, float]], kinds: np.nd
     kinds = np.full(len(poses), TEAMMATE) if kinds is None else kinds
     ages = np.zeros(len(poses))
     return [
-        filter_command(v, w, i, poses, ages, kinds, GROUND, SCENARIO.cell, SAFETY, np.zeros(2, dtype=np.int64))
+        filter_command(
+            v, w, i, poses, ages, kinds, GROUND, SCENARIO.cell, SAFETY, np.zeros(MEMORY_SIZE, dtype=np.int64)
+        )
         for i, (v, w) in enumerate(nominal)
     ]
 
@@ -102,7 +105,7 @@ def test_a_stale_teammate_in_range_stops_the_robot() -> None:
     poses = np.array([[10.0, 10.0, 0.0], [13.0, 10.0, math.pi]])
     ages = np.array([0.0, SAFETY.max_pose_age + 0.01])
     kinds = np.array([TEAMMATE, TEAMMATE])
-    memory = np.zeros(2, dtype=np.int64)
+    memory = np.zeros(MEMORY_SIZE, dtype=np.int64)
     assert filter_command(1.0, 0.0, 0, poses, ages, kinds, GROUND, 1.0, SAFETY, memory) == (0.0, 0.0, STALE_NEIGHBOUR)
     far = np.array([[10.0, 10.0, 0.0], [40.0, 10.0, math.pi]])
     assert filter_command(1.0, 0.0, 0, far, ages, kinds, GROUND, 1.0, SAFETY, memory) == (1.0, 0.0, 0)
@@ -112,7 +115,7 @@ def test_an_old_pose_widens_the_margin() -> None:
     """A pose younger than max_pose_age: the clearance grows by how far the teammate's point can have gone."""
     gap = POINTS_APART + 2 * SAFETY.lookahead + 0.3
     poses = np.array([[10.0, 10.0, 0.0], [10.0 + gap, 10.0, math.pi]])
-    kinds, memory = np.array([TEAMMATE, TEAMMATE]), np.zeros(2, dtype=np.int64)
+    kinds, memory = np.array([TEAMMATE, TEAMMATE]), np.zeros(MEMORY_SIZE, dtype=np.int64)
     fresh = filter_command(1.0, 0.0, 0, poses, np.zeros(2), kinds, GROUND, 1.0, SAFETY, memory)
     aged = filter_command(1.0, 0.0, 0, poses, np.array([0.0, 0.4]), kinds, GROUND, 1.0, SAFETY, memory)
     assert aged[0] < fresh[0]
@@ -123,7 +126,7 @@ def test_a_deadlock_is_found_then_resolved_by_keeping_right() -> None:
     STUCK_STEPS each turns to its right, they pass, and the straight command passes the filter again."""
     poses = np.array([[10.0, 10.0, 0.0], [16.0, 10.0, math.pi]])
     goals = np.array([[22.0, 10.0], [4.0, 10.0]])
-    memory = np.zeros((2, 2), dtype=np.int64)
+    memory = np.zeros((2, MEMORY_SIZE), dtype=np.int64)
     seen = 0
     closest = math.inf
     for _ in range(600):
@@ -134,7 +137,16 @@ def test_a_deadlock_is_found_then_resolved_by_keeping_right() -> None:
             v_hat, w_hat = V_MAX * max(0.0, math.cos(error)), OMEGA_MAX / math.pi * error
             commands.append(
                 filter_command(
-                    v_hat, w_hat, i, poses, np.zeros(2), np.zeros(2, dtype=np.int64), GROUND, 1.0, SAFETY, memory[i]
+                    v_hat,
+                    w_hat,
+                    i,
+                    poses,
+                    np.zeros(2),
+                    np.zeros(MEMORY_SIZE, dtype=np.int64),
+                    GROUND,
+                    1.0,
+                    SAFETY,
+                    memory[i],
                 )
             )
         seen |= commands[0][2] | commands[1][2]
@@ -158,7 +170,7 @@ def test_a_robot_driven_into_a_wall_keeps_the_margin_and_slides_along_it() -> No
     )
     ground, safety = world_of(scenario).ground, safety_parameters(scenario)
     pose = np.array([[8.0, 10.0, 0.0]])
-    memory = np.zeros(2, dtype=np.int64)
+    memory = np.zeros(MEMORY_SIZE, dtype=np.int64)
     gaps = []
     for _ in range(200):
         v, omega, _ = filter_command(
@@ -191,7 +203,7 @@ def test_a_wall_keeps_its_barrier(x: float, y: float, theta: float, v_hat: float
     h = wall_gap(x, y)
     assume(h >= 0.0)
     pose = np.array([[x, y, theta]])
-    memory = np.zeros(2, dtype=np.int64)
+    memory = np.zeros(MEMORY_SIZE, dtype=np.int64)
     v, omega, _ = filter_command(
         v_hat, w_hat, 0, pose, np.zeros(1), np.zeros(1, dtype=np.int64), WALLED_GROUND, 1.0, WALLED_SAFETY, memory
     )

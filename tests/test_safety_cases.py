@@ -1,10 +1,11 @@
-"""The three deadlock cases of issue 12 (scenarios/deadlocks/): each resolves, in process and over Zenoh.
+"""The deadlock cases of issue 12 (scenarios/deadlocks/): each resolves, in process and over Zenoh.
 
 Corridor: two robots head-on, each sent to the other's start (exactly symmetric: the filter alone holds
 both, so a deadlock must be found). Corners: four robots swapping corners through the centre. Parked:
 a robot's objective lies behind a teammate parked on its own objective. Resolved means every robot
 gets within R/2 of its objective (where eq. 10 stops it) while no two ever come closer than 2r + s
-(less the arc's departure from its chord between steps).
+(less the arc's departure from its chord between steps). Side by side: two robots within R/2 of one
+objective, each turning to look at it into the other's barrier; resolved means both come to face it.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 import pytest
 
 from anicov.engine import run_scenario
+from model.safety import KEEPING_RIGHT
 from model.scenario import PAPER_SCENARIO, load_scenario
 from runtime.rundir import summary_of
 from tests.teamrun import anicov, launcher_command, processes_of, run, unique_team
@@ -41,6 +43,26 @@ def test_each_deadlock_case_resolves_in_process(case):
         assert summary["min_clearance"] >= scenario.robot_radius + scenario.safety_margin - 1e-9
 
 
+def bearing_error(result, objectives: np.ndarray) -> np.ndarray:
+    """Per robot, the least angle (degrees) between its heading and the bearing to its objective."""
+    trace = result.trace
+    bearing = np.arctan2(objectives[None, :, 1] - trace[:, :, 1], objectives[None, :, 0] - trace[:, :, 0])
+    return np.degrees(np.abs(np.angle(np.exp(1j * (trace[:, :, 2] - bearing)))).min(axis=0))
+
+
+def test_robots_side_by_side_turning_to_one_objective_both_come_to_face_it():
+    """Keeping right alone would leave both frozen 50-57 degrees off (measured: 83 deadlocks found and
+    'resolved' in 60 time units): the higher id yields and each then turns to face the objective."""
+    scenario = load_scenario(CASES / "side-by-side.toml")
+    result = run_scenario(scenario)
+    summary = summary_of(result)
+    assert (bearing_error(result, np.array(scenario.objectives)) < 1.0).all()
+    assert summary["min_separation"] >= 2 * scenario.robot_radius + scenario.safety_margin - ARC_SLACK
+    assert 1 <= summary["deadlocks"] <= 3 and summary["deadlocks_resolved"] == summary["deadlocks"]
+    assert (result.safety_flags[:, 1] & KEEPING_RIGHT).sum() >= 10  # robot 1 drove its yield
+    assert (result.safety_flags[:, 0] & KEEPING_RIGHT).sum() < (result.safety_flags[:, 1] & KEEPING_RIGHT).sum()
+
+
 def test_without_the_filter_the_corridor_robots_drive_through_each_other():
     """The same corridor with ``safety = false``: the disks overlap (what the filter is there to stop)."""
     scenario = load_scenario(CASES / "corridor.toml").with_overrides(safety=False)
@@ -49,7 +71,7 @@ def test_without_the_filter_the_corridor_robots_drive_through_each_other():
     assert summary["deadlocks"] == 0 and summary["filter_active_fraction"] == 0.0
 
 
-@pytest.mark.parametrize("case", ["corridor", "corners", "parked"])
+@pytest.mark.parametrize("case", ["corridor", "corners", "parked", "side-by-side"])
 def test_each_deadlock_case_resolves_over_zenoh_as_in_process(tmp_path, case):
     config = CASES / f"{case}.toml"
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
