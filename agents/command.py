@@ -20,8 +20,20 @@ if TYPE_CHECKING:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--id", type=int, required=True, help="this agent's id, 0..N-1")
     parser.add_argument("--counts", help="write message counters to this JSON file at exit")
+    add_deltas_argument(parser)
     add_process_arguments(parser)
     add_robot_arguments(parser)
+
+
+def add_deltas_argument(parser: argparse.ArgumentParser) -> None:
+    """How an agent's map deltas travel (protocol.events); the run is the same either way."""
+    parser.add_argument(
+        "--deltas",
+        choices=("event", "cells"),
+        default="event",
+        help="event (default): each step's sensing event, ~65 bytes, every replica computes the cells; "
+        "cells: the cells themselves (~2.4 kB on the paper's sensor)",
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -35,7 +47,7 @@ def main(args: argparse.Namespace) -> int:
     scenario = scenario_from_arguments(args)
     if not 0 <= args.id < scenario.agents:
         raise ScenarioError(f"--id: expected an agent id from 0 to {scenario.agents - 1}, got {args.id}")
-    options = AgentOptions(args.team, args.id, args.clock, args.speed, args.drop_rate, args.counts)
+    options = AgentOptions(args.team, args.id, args.clock, args.speed, args.drop_rate, args.counts, args.deltas)
     ros2 = ros2_options(args, scenario) if args.robot == "ros2" else None
     return run_agent(scenario, options, config_from_arguments(args), stop, ros2)
 

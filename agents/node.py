@@ -13,6 +13,7 @@ import numpy as np
 
 from agents.robot import Robot, SimulatedUnicycle
 from model.coverage_map import load_kernels as load_map_kernels
+from model.exact_coverage import load_kernels as load_event_kernel
 from model.ground import NO_FIELD
 from model.parameters import law_parameters, safety_parameters, starting_poses
 from model.safety import MEMORY_SIZE, PARKED, POSE_STALE, RAN_LATE, TEAMMATE, filter_command
@@ -20,6 +21,7 @@ from model.safety import load_kernels as load_safety_kernels
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, load_kernels
 from model.world import world_of
+from protocol.events import as_event
 from protocol.inbox import Inbox, Membership, Received
 from protocol.keys import TeamKeys
 from protocol.messages import AgentState, AgentStep, Limits, MapDelta, Objectives, Pose, RunControl, Snapshot, StepGo
@@ -37,6 +39,7 @@ class AgentOptions:
     speed: float = 1.0
     drop_rate: float = 0.0
     counts_file: str | None = None
+    deltas: str = "event"  # how this agent's deltas travel: "event" or "cells" (protocol.events)
 
 
 class AgentNode:
@@ -244,6 +247,8 @@ class AgentNode:
                 self.safety_memory,
             )
         delta = MapDelta(self.options.agent, self.step, row0, col0, ticks)
+        if self.options.deltas == "event":
+            delta = as_event(delta, pose, self.limits.kernel)
         self.replica.apply(delta)
         next_pose = self.robot.command(v, omega)
         v, omega = self.robot.last_command  # a real base's limits may have cut it
@@ -274,6 +279,7 @@ class AgentNode:
         load_kernels(self.replica.map.coverage, self.robot.pose(), self.law, self.ground)
         load_safety_kernels(self.safety, self.ground, self.law.cell, self.scenario.agents)
         load_map_kernels()
+        load_event_kernel(self.limits.kernel)
 
     def hello(self) -> AgentState:
         pose = self.robot.pose()

@@ -21,6 +21,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from agents.command import add_deltas_argument
 from anicov.ros2_team import add_ros2_team_arguments, check_ros2_team, ros2_agent_flags, test_base_commands
 from model.scenario import Scenario
 from runtime.arguments import add_team_arguments, scenario_from_arguments
@@ -77,6 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="mutual TLS and access control from a profile made by 'anicov certs --out DIR'",
     )
     parser.add_argument("--team", default="team", help="team name: keys live under anicov/<team>/")
+    add_deltas_argument(parser)
     parser.add_argument("--out", help="run directory (default runs/<date-time>)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--no-record", action="store_true", help="no logger, no OUT/recording.rrd")
@@ -163,7 +165,8 @@ def wait_for_exit(children: list[Child], timeout: float) -> None:
 def warm_numba_cache(scenario: Scenario) -> None:
     """Compile (or load) the jitted kernels once here, so N children do not all compile at once."""
     from model.coverage_map import load_kernels as load_map_kernels
-    from model.parameters import coverage_map_of, law_parameters, safety_parameters, starting_poses
+    from model.exact_coverage import load_kernels as load_event_kernel
+    from model.parameters import coverage_map_of, exact_kernel_of, law_parameters, safety_parameters, starting_poses
     from model.safety import load_kernels as load_safety_kernels
     from model.step import load_kernels
     from model.world import world_of
@@ -172,6 +175,7 @@ def warm_numba_cache(scenario: Scenario) -> None:
     load_kernels(grid.coverage, tuple(starting_poses(scenario)[0]), law_parameters(scenario, grid), ground)
     load_safety_kernels(safety_parameters(scenario), ground, scenario.cell, scenario.agents)
     load_map_kernels()
+    load_event_kernel(exact_kernel_of(scenario))
 
 
 @dataclass
@@ -290,7 +294,14 @@ def start_team(args: argparse.Namespace, agents: int, out_dir: Path, children: l
             logger_flags += ["--serve", "--web-port", str(args.web_port), "--grpc-port", str(args.grpc_port)]
         children.append(spawn("logger", child_command("logger", args, logger_flags), logs))
     for agent in range(agents):
-        agent_flags = ["--id", str(agent), "--counts", str(logs / f"agent-{agent}.counts.json")]
+        agent_flags = [
+            "--id",
+            str(agent),
+            "--counts",
+            str(logs / f"agent-{agent}.counts.json"),
+            "--deltas",
+            args.deltas,
+        ]
         agent_flags += ros2_agent_flags(args, agent)
         name = f"agent-{agent}"
         children.append(spawn(name, child_command("agent", args, agent_flags, identity=name), logs))

@@ -20,6 +20,7 @@ from coordinator.node import Coordinator, CoordinatorOptions
 from coordinator.startup import gather_team, resume_running_team
 from coordinator.stepping import Stepping
 from model.coverage_map import load_kernels as load_map_kernels
+from model.exact_coverage import load_kernels as load_event_kernel
 from model.scenario import Scenario
 from protocol.messages import RunControl
 from protocol.recovery import LossTimer
@@ -37,6 +38,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
         loss = LossTimer()  # from here, as before: the first step's patience includes the start
         settle_garbage_collector()
         load_map_kernels()  # while the agents start, not in step 0
+        load_event_kernel(node.limits.kernel)
         found = gather_team(bus, options.await_logger, stop, parent)
         step = 0
         if found.running:

@@ -19,6 +19,7 @@ from functools import partial
 import zenoh
 
 from logger.team_logger import LoggerOptions, TeamLogger
+from model.exact_coverage import load_kernels as load_event_kernel
 from model.scenario import Scenario
 from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_digest, digest_of
 from protocol.keys import TeamKeys
@@ -57,6 +58,7 @@ def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config,
         _load_snapshot(session, keys, node)
         token = session.liveliness().declare_token(keys.alive("logger"))
         settle_garbage_collector()
+        load_event_kernel(node.limits.kernel)  # it decodes every event of the team
         read_gos = partial(_read_gos, session, keys, node) if lockstep else None
         _follow(node, read_gos, lambda: stop.stopped or parent_is_gone(parent))
         _drain(node, read_gos)

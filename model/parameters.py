@@ -11,6 +11,7 @@ import numpy as np
 
 from model.clearance import disk_is_free
 from model.coverage_map import CoverageMap
+from model.exact_coverage import ExactKernel, exact_kernel
 from model.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
 from model.scenario_safety import point_speed
@@ -33,6 +34,17 @@ def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParamete
         literal_heading=scenario.controller == "paper-literal",
         literal_omega=scenario.controller in ("paper-literal", "paper-eq16"),
     )
+
+
+def exact_kernel_of(scenario: Scenario) -> ExactKernel | None:
+    """The integer coverage kernel of a scenario's sensor and grid (model.exact_coverage), or None where
+    its numbers do not fit (a domain or range over 2²⁰ units): deltas then travel as cells."""
+    try:
+        return exact_kernel(
+            *scenario.grid_shape, scenario.cell, scenario.range, scenario.half_angle, scenario.alpha_max, scenario.dt
+        )
+    except ValueError:
+        return None
 
 
 def coverage_map_of(scenario: Scenario) -> CoverageMap:

@@ -14,6 +14,8 @@ from typing import Any
 import msgpack
 import numpy as np
 
+from model.exact_coverage import event_window
+from protocol.events import delta_of_event
 from protocol.messages import (
     MAX_PAYLOAD_BYTES,
     PROTOCOL_VERSION,
@@ -28,6 +30,7 @@ from protocol.messages import (
     ProtocolError,
     RunControl,
     ScenarioDigest,
+    SensingEvent,
     Snapshot,
     StepGo,
 )
@@ -97,10 +100,38 @@ def _members(body: dict[str, Any], last_agent: int) -> list[int]:
     return members
 
 
+MAX_EVENT_COORDINATE = 2.0**20
+"""An event's x, y (and θ) beyond this are refused: the integer kernel holds positions up to 2²² units."""
+MAX_TICKS = 2**40
+
+
+def _decode_event(body: dict[str, Any], limits: Limits, agent: int, seq: int) -> MapDelta:
+    """A delta sent as its sensing event (protocol.events): the pose, then the fixes, checked against the
+    integer kernel's window before anything is computed from them."""
+    if limits.kernel is None:
+        raise ProtocolError("no-kernel", "this team's deltas cannot travel as events")
+    x, y, theta = _floats(body, "ev", 3)
+    if max(abs(x), abs(y), abs(theta)) > MAX_EVENT_COORDINATE:
+        raise ProtocolError("out-of-range", "an event's pose lies too far out")
+    row0, row1, col0, col1 = event_window(limits.kernel, x, y)
+    cells = max(row1 - row0, 0) * max(col1 - col0, 0)
+    numbers = body.get("fix")
+    if not isinstance(numbers, list) or len(numbers) % 2 or len(numbers) > 2 * cells:
+        raise ProtocolError("bad-shape", "fix must be [index, ticks, ...], at most one per window cell")
+    fixes = []
+    for k in range(0, len(numbers), 2):
+        low = fixes[-1][0] + 1 if fixes else 0
+        index = _int({"index": numbers[k]}, "index", low, cells - 1)
+        fixes.append((index, _int({"ticks": numbers[k + 1]}, "ticks", 0, MAX_TICKS)))
+    return delta_of_event(agent, seq, SensingEvent((x, y, theta), tuple(fixes)), limits.kernel)
+
+
 def _decode_delta(body: dict[str, Any], limits: Limits) -> MapDelta:
     last_agent = limits.agents - 1
     agent = _int(body, "agent", 0, last_agent)
     seq = _int(body, "seq", 0, MAX_STEP)
+    if "ev" in body:
+        return _decode_event(body, limits, agent, seq)
     height = _int(body, "h", 0, limits.rows)
     width = _int(body, "w", 0, limits.cols)
     row0 = _int(body, "row0", 0, limits.rows)

@@ -7,6 +7,8 @@ Encoding (here) never fails for a well-formed value; decoding
 decode may touch a map or a controller.
 
     MapDelta    agent, seq (= step), window (row0, col0, ticks int64 h×w)   eq. 3
+                on the wire as cells (the window's ticks) or as a sensing event (the pose the step sensed
+                from and the cells whose ticks the integer kernel rounds otherwise): protocol.events
     AgentState  agent, step, pose at t_k, v, ω, e_Ω, pose at t_k+1 (step −1: hello), safety filter flags
     AgentStep   what an agent publishes each step: its MapDelta and its AgentState
     StepGo      lockstep: step k may start; every member's step k−1 delta and state
@@ -25,11 +27,16 @@ from typing import Any
 import msgpack
 import numpy as np
 
+from model.exact_coverage import ExactKernel
+from model.parameters import exact_kernel_of
 from model.scenario import Scenario
 
 PROTOCOL_VERSION = 1
 MAX_PAYLOAD_BYTES = 8 * 1024 * 1024
 """Larger payloads are rejected before decoding (a snapshot of a 1000×1000 map compresses far below)."""
+
+
+Pose = tuple[float, float, float]
 
 
 class ProtocolError(ValueError):
@@ -42,19 +49,30 @@ class ProtocolError(ValueError):
 
 @dataclass(frozen=True)
 class Limits:
-    """What a receiver accepts: the grid it holds and the team size."""
+    """What a receiver accepts: the grid it holds and the team size; and the integer coverage kernel
+    that turns a delta sent as a sensing event into ticks (None: events are refused)."""
 
     rows: int
     cols: int
     agents: int
+    kernel: ExactKernel | None = None
 
     @classmethod
     def of(cls, scenario: Scenario) -> Limits:
-        """The limits of a scenario's team: its grid and its size."""
-        return cls(*scenario.grid_shape, scenario.agents)
+        """The limits of a scenario's team: its grid, its size and its sensor's integer kernel."""
+        return cls(*scenario.grid_shape, scenario.agents, exact_kernel_of(scenario))
 
 
 Pose = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class SensingEvent:
+    """The cause of a delta (issue 13): the pose a step sensed from, and the cells (flat index in the
+    integer kernel's window, ticks) where the sender's ticks differ from that kernel's."""
+
+    pose: Pose
+    fixes: tuple[tuple[int, int], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -64,6 +82,7 @@ class MapDelta:
     row0: int
     col0: int
     ticks: np.ndarray  # int64 (h, w), non-negative
+    event: SensingEvent | None = None  # set: it travels as this event (protocol.events), not as cells
 
 
 @dataclass(frozen=True)
@@ -156,6 +175,9 @@ def _pack(kind: str, body: dict[str, Any]) -> bytes:
 
 
 def _delta_body(message: MapDelta) -> dict[str, Any]:
+    if message.event is not None:
+        fixes = [number for fix in message.event.fixes for number in fix]
+        return {"agent": message.agent, "seq": message.seq, "ev": list(message.event.pose), "fix": fixes}
     ticks = np.ascontiguousarray(message.ticks, dtype="<i8")
     return {
         "agent": message.agent,

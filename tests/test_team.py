@@ -26,16 +26,23 @@ def assert_same_run(engine_dir, team_dir):
 
 
 @pytest.mark.parametrize(
-    ("agents", "domain", "bus"),
-    [(1, [40.0, 40.0], "peer"), (1, [40.0, 40.0], "client"), (4, [100.0, 100.0], "peer")],
-    ids=["N=1", "N=1-through-the-router", "N=4-paper"],
+    ("agents", "domain", "bus", "deltas"),
+    [
+        (1, [40.0, 40.0], "peer", "event"),
+        (1, [40.0, 40.0], "client", "event"),
+        (1, [40.0, 40.0], "peer", "cells"),
+        (4, [100.0, 100.0], "peer", "event"),
+    ],
+    ids=["N=1", "N=1-through-the-router", "N=1-deltas-as-cells", "N=4-paper"],
 )
-def test_lockstep_over_zenoh_equals_in_process_engine_byte_for_byte(tmp_path, agents, domain, bus):
+def test_lockstep_over_zenoh_equals_in_process_engine_byte_for_byte(tmp_path, agents, domain, bus, deltas):
+    """Deltas travel as sensing events by default (protocol.events), or as cells: the same run."""
     config = write_scenario(tmp_path / "s.toml", domain=domain, agents=agents, seed=3)
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet")
     assert engine.returncode == 0, engine.stderr
     team = unique_team()
-    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--bus", bus, team=team))
+    flags = ("--bus", bus, "--deltas", deltas)
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), *flags, team=team))
     assert launched.returncode == 0, launched.stderr + launched.stdout
     assert "coverage        complete" in launched.stdout
     assert_same_run(tmp_path / "engine", tmp_path / "team")
