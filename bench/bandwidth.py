@@ -97,7 +97,9 @@ def main() -> None:
     parser.add_argument("--speed", type=float, default=1.0, help="realtime speed (default 1: 10 steps/s)")
     args = parser.parse_args()
     print(f"# {describe_machine()}")
-    print("| N | deltas | agent-steps | bytes/agent-step (all) | step message | rest | out/robot at speed 1 | in/robot |")
+    print(
+        "| N | deltas | agent-steps | bytes/agent-step (all) | step message | rest | out/robot at speed 1 | in/robot |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     results = []
     for agents in args.n:
