@@ -28,6 +28,7 @@ import zenoh
 
 from bench.machine import describe_machine
 from bench.pingpong import free_port
+from protocol.messages import COMPACT_STEP
 from protocol.session import zenoh_config
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -60,6 +61,10 @@ def measure(agents: int, deltas: str, max_time: float, speed: float) -> dict[str
 
         def on_sample(sample: zenoh.Sample) -> None:
             payload = sample.payload.to_bytes()
+            if payload[:1] == bytes([COMPACT_STEP]):
+                by_type["step"] += len(payload)
+                count["step"] += 1
+                return
             try:
                 kind = msgpack.unpackb(payload, raw=False).get("type", "?")
             except Exception:

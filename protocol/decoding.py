@@ -7,6 +7,8 @@ here may touch a map or a controller.
 from __future__ import annotations
 
 import math
+import struct
+import time
 import zlib
 from collections.abc import Callable
 from typing import Any
@@ -17,9 +19,18 @@ import numpy as np
 from model.exact_coverage import event_window
 from protocol.events import delta_of_event
 from protocol.messages import (
+    COMPACT_COUNT,
+    COMPACT_FIX,
+    COMPACT_HEAD,
+    COMPACT_STAMP,
+    COMPACT_STEP,
+    FIXED,
     MAX_PAYLOAD_BYTES,
+    NOTHING_SENSED,
     PROTOCOL_VERSION,
     RUN_CONTROL_KINDS,
+    STAMP_UNITS,
+    STAMPED,
     AgentState,
     AgentStep,
     Limits,
@@ -296,8 +307,47 @@ _DECODERS: dict[str, Callable[[dict[str, Any], Limits], Message]] = {
 """Each message type's decoder: it validates the body and builds the message, or raises ProtocolError."""
 
 
+def _decode_compact_step(payload: bytes, limits: Limits) -> AgentStep:
+    """A compact step (protocol.messages.COMPACT_STEP), checked as the msgpack form is."""
+    if len(payload) < COMPACT_HEAD.size:
+        raise ProtocolError("bad-shape", "a compact step is too short")
+    _, version, what, agent, step, safety, *numbers = COMPACT_HEAD.unpack_from(payload)
+    if version != PROTOCOL_VERSION:
+        raise ProtocolError("bad-version", f"expected {PROTOCOL_VERSION}, got {version!r}")
+    if what & ~(STAMPED | FIXED | NOTHING_SENSED) or (what & FIXED and what & NOTHING_SENSED):
+        raise ProtocolError("bad-field", "unknown parts in a compact step")
+    offset, stamp, fixes = COMPACT_HEAD.size, 0.0, []
+    try:
+        if what & STAMPED:
+            (ticks,) = COMPACT_STAMP.unpack_from(payload, offset)
+            offset += COMPACT_STAMP.size
+            now = round(time.time() * STAMP_UNITS)
+            stamp = (now - (now - ticks) % 2**32) / STAMP_UNITS  # the latest time with these low bits
+        if what & FIXED:
+            (count,) = COMPACT_COUNT.unpack_from(payload, offset)
+            offset += COMPACT_COUNT.size
+            for _ in range(count):
+                fixes.extend(COMPACT_FIX.unpack_from(payload, offset))
+                offset += COMPACT_FIX.size
+    except struct.error:
+        raise ProtocolError("bad-shape", "a compact step ends early") from None
+    if offset != len(payload):
+        raise ProtocolError("bad-shape", "bytes after a compact step")
+    names = ("pose", "pose", "pose", "v", "omega", "e_omega", "next", "next", "next")
+    x, y, theta, v, omega, e_omega, *after = (_finite(n, name) for n, name in zip(numbers, names, strict=True))
+    state_body = {"agent": agent, "step": step, "pose": [x, y, theta], "vel": [v, omega], "e_omega": e_omega}
+    state = _decode_state(state_body | {"next": after, "safety": safety, "stamp": stamp}, limits)
+    if what & NOTHING_SENSED:
+        return AgentStep(MapDelta(state.agent, step, 0, 0, np.zeros((0, 0), dtype=np.int64)), state)
+    return AgentStep(_decode_event({"ev": [x, y, theta], "fix": fixes}, limits, state.agent, step), state)
+
+
 def decode(payload: bytes, limits: Limits, expected: str | None = None) -> Message:
     """Decode and validate one payload; raise ProtocolError (with ``.reason``) if it is not acceptable."""
+    if isinstance(payload, bytes | bytearray | memoryview) and payload[:1] == bytes([COMPACT_STEP]):
+        if expected is not None and expected != "step":
+            raise ProtocolError("wrong-type", f"expected {expected}, got 'step'")
+        return _decode_compact_step(bytes(payload), limits)
     body = _header(payload)
     kind = body.get("type")
     if expected is not None and kind != expected:

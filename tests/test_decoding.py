@@ -64,7 +64,8 @@ def good_delta(**changes):
     ("payload", "reason"),
     [
         (b"", "undecodable"),
-        (b"\xc1garbage", "undecodable"),
+        (b"\xc1garbage", "bad-shape"),  # 0xC1 opens a compact step: too short for one
+        (b"\xc0\xc1", "undecodable"),  # msgpack nil, then a byte msgpack never uses
         (msgpack.packb([1, 2, 3]), "not-a-map"),
         (msgpack.packb({"v": 99, "type": "delta"}), "bad-version"),
         (body(type="teleport"), "unknown-type"),
@@ -122,3 +123,35 @@ def test_mutated_delta_is_either_valid_or_rejected(position, value):
     if isinstance(message, MapDelta):
         assert (message.ticks >= 0).all()
         assert message.row0 + message.ticks.shape[0] <= 100 and message.col0 + message.ticks.shape[1] <= 100
+
+
+def test_a_malformed_compact_step_is_rejected():
+    import struct
+
+    from model.scenario import PAPER_SCENARIO, load_scenario
+    from protocol.messages import COMPACT_HEAD
+
+    limits = Limits.of(load_scenario(PAPER_SCENARIO))
+    numbers = (50.0, 50.0, 0.5, 0.5, 0.1, 0.2, 50.1, 50.0, 0.51)
+
+    def compact(*, version=PROTOCOL_VERSION, what=0, agent=1, step=4, safety=0, floats=numbers, tail=b""):
+        return COMPACT_HEAD.pack(0xC1, version, what, agent, step, safety, *floats) + tail
+
+    def reason(payload: bytes) -> str:
+        with pytest.raises(ProtocolError) as caught:
+            decode(payload, limits)
+        return caught.value.reason
+
+    assert decode(compact(), limits).state.step == 4
+    assert reason(compact()[:-1]) == "bad-shape"
+    assert reason(compact(tail=b"x")) == "bad-shape"
+    assert reason(compact(version=9)) == "bad-version"
+    assert reason(compact(what=8)) == reason(compact(what=6)) == "bad-field"
+    assert reason(compact(what=2, tail=struct.pack("<H", 1))) == "bad-shape"  # one fix announced, none there
+    assert reason(compact(agent=4)) == "out-of-range"
+    assert reason(compact(floats=(*numbers[:5], 1.5, *numbers[6:]))) == "out-of-range"  # e_Ω > 1
+    assert reason(compact(floats=(math.nan, *numbers[1:]))) == "not-finite"
+    assert reason(compact(what=2, tail=struct.pack("<HIQ", 1, 10**6, 1))) == "out-of-range"  # past the window
+    with pytest.raises(ProtocolError) as caught:
+        decode(compact(), limits, expected="go")
+    assert caught.value.reason == "wrong-type"
