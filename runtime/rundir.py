@@ -126,6 +126,34 @@ def _safety_line(summary: dict[str, Any]) -> str:
     )
 
 
+def bandwidth_of(agent_counts: list[dict[str, Any]], dt: float) -> dict[str, Any] | None:
+    """Bytes each robot sent and took in over the run (its counters: every payload it published and every
+    one its inbox received), per step and per second at speed 1 (1/dt steps a second); None if no agent
+    stepped."""
+    stepped = [counts for counts in agent_counts if counts.get("steps", 0) > 0]
+    if not stepped:
+        return None
+    out = [counts["bytes_sent"] / counts["steps"] for counts in stepped]
+    into = [counts["bytes_received"] / counts["steps"] for counts in stepped]
+    return {
+        "agents_counted": len(stepped),
+        "bytes_out_per_step": sum(out) / len(out),
+        "bytes_in_per_step": sum(into) / len(into),
+        "bytes_out_per_second_at_speed_1": sum(out) / len(out) / dt,
+        "bytes_in_per_second_at_speed_1": sum(into) / len(into) / dt,
+        "max_bytes_in_per_step": max(into),
+    }
+
+
+def format_bandwidth(bandwidth: dict[str, Any], deltas: str) -> str:
+    """The summary's line of what each robot's radio carried."""
+    return (
+        f"  bus per robot   out {bandwidth['bytes_out_per_step']:.0f} B, in {bandwidth['bytes_in_per_step']:.0f} B a step"
+        f" (deltas as {'events' if deltas == 'event' else 'cells'}); at speed 1: out {8e-3 * bandwidth['bytes_out_per_second_at_speed_1']:.1f} kbit/s,"
+        f" in {8e-3 * bandwidth['bytes_in_per_second_at_speed_1']:.1f} kbit/s"
+    )
+
+
 def write_counts(path: str | Path | None, counts: dict[str, object]) -> None:
     """Persist a process's message counters (read by tests and by whoever studies a run); None: nowhere."""
     if path:

@@ -36,3 +36,21 @@ def test_counts_go_nowhere_without_a_path(tmp_path):
     assert list(tmp_path.iterdir()) == []
     write_counts(str(tmp_path / "c.json"), {"b": 2, "a": 1})
     assert (tmp_path / "c.json").read_text() == '{\n  "a": 1,\n  "b": 2\n}\n'
+
+
+def test_bandwidth_is_per_robot_and_step_and_per_second_at_speed_one():
+    from runtime.rundir import bandwidth_of, format_bandwidth
+
+    counts = [
+        {"steps": 100, "bytes_sent": 8200, "bytes_received": 30000},
+        {"steps": 50, "bytes_sent": 4300, "bytes_received": 10000},
+        {"steps": 0, "bytes_sent": 0, "bytes_received": 500},  # a robot that never stepped is left out
+    ]
+    bandwidth = bandwidth_of(counts, dt=0.1)
+    assert bandwidth["agents_counted"] == 2
+    assert bandwidth["bytes_out_per_step"] == (82 + 86) / 2 and bandwidth["bytes_in_per_step"] == (300 + 200) / 2
+    assert bandwidth["bytes_out_per_second_at_speed_1"] == 840.0 and bandwidth["max_bytes_in_per_step"] == 300
+    assert "out 84 B, in 250 B a step (deltas as events); at speed 1: out 6.7 kbit/s, in 20.0 kbit/s" in (
+        format_bandwidth(bandwidth, "event")
+    )
+    assert bandwidth_of(counts[2:], dt=0.1) is None

@@ -49,6 +49,10 @@ def test_lockstep_over_zenoh_equals_in_process_engine_byte_for_byte(tmp_path, ag
     counts = json.loads((tmp_path / "team" / "coordinator_counts.json").read_text())
     assert counts["rejected"] == 0 and counts["gaps"] == 0
     assert processes_of(team) == []
+    # What each robot sent a step: its compact step (82 bytes) with events, some 2.4 kB of cells without.
+    bandwidth = json.loads((tmp_path / "team" / "bandwidth.json").read_text())
+    assert "bus per robot" in launched.stdout
+    assert (bandwidth["bytes_out_per_step"] < 100) == (deltas == "event")
 
 
 def test_thirty_agent_processes_equal_the_engine(tmp_path):
