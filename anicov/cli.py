@@ -102,6 +102,27 @@ def command_safety_study(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def command_sweep(args: argparse.Namespace) -> int:
+    from anicov.sweep import load_sweep, run_sweep
+
+    sweep = load_sweep(Path(args.sweep))
+    if args.workers is not None and args.workers < 1:
+        raise ScenarioError(f"--workers: expected a positive number, got {args.workers}")
+    total = len(list(sweep.points()))
+    found, made = run_sweep(sweep, Path(args.out), args.workers, args.cluster, progress=not args.quiet)
+    where = f"on the cluster at {args.cluster}" if args.cluster else "on this machine"
+    print(f"sweep: {total} runs; {found} found done in {args.out}/runs.csv, {made} run now {where}")
+    return EXIT_OK
+
+
+def command_sweep_plot(args: argparse.Namespace) -> int:
+    from anicov.sweep import plot_sweep
+
+    path = Path(args.png) if args.png else Path(args.out) / f"{args.y}_by_{args.x}.png"
+    print(f"plot written to {plot_sweep(Path(args.out), args.x, args.y, args.by, path)}")
+    return EXIT_OK
+
+
 def command_router(args: argparse.Namespace) -> int:
     import zenoh
 
@@ -155,6 +176,7 @@ def build_parser() -> argparse.ArgumentParser:
         command = commands.add_parser(name, help=text)
         part.add_arguments(command)
         command.set_defaults(handler=part.main)
+    _add_sweep(commands)
     _add_bus_tools(commands)
     launch = commands.add_parser("launch", help="a whole team on this machine (same as launch_team.py)", add_help=False)
     launch.add_argument("rest", nargs=argparse.REMAINDER)
@@ -200,6 +222,25 @@ def _add_in_process_commands(commands: argparse._SubParsersAction) -> None:
     safety.add_argument("--maps", default="warehouse,office,field", help="shipped maps, N = 4 and 10 (or none)")
     safety.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
     safety.set_defaults(handler=command_safety_study)
+
+
+def _add_sweep(commands: argparse._SubParsersAction) -> None:
+    """sweep, sweep-plot: grids of runs into one table (issue 14)."""
+    sweep = commands.add_parser("sweep", help="a grid of runs from a TOML file into one table (OUT/runs.csv)")
+    sweep.add_argument("sweep", help="the sweep file (see anicov/sweep.py and sweeps/)")
+    sweep.add_argument("--out", required=True, help="output directory; a sweep started again there resumes")
+    sweep.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    sweep.add_argument("--cluster", metavar="ADDRESS", help="a Dask distributed scheduler, e.g. tcp://host:8786")
+    sweep.add_argument("--quiet", action="store_true", help="no progress bar")
+    sweep.set_defaults(handler=command_sweep)
+
+    plot = commands.add_parser("sweep-plot", help="a figure of a sweep's table against one of its keys (PNG)")
+    plot.add_argument("out", help="the sweep's output directory")
+    plot.add_argument("--x", required=True, help="the key on the x axis, e.g. agents")
+    plot.add_argument("--y", required=True, help="the figure on the y axis, e.g. time_ratio")
+    plot.add_argument("--by", help="one line per value of this key, e.g. controller")
+    plot.add_argument("--png", help="where to write it (default OUT/<y>_by_<x>.png)")
+    plot.set_defaults(handler=command_sweep_plot)
 
 
 def _add_bus_tools(commands: argparse._SubParsersAction) -> None:

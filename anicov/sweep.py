@@ -1,0 +1,252 @@
+"""``anicov sweep``: a grid of runs over scenario keys, controllers, team sizes and seeds, from a TOML file,
+into one tidy table (issue 14).
+
+A sweep file::
+
+    scenario = "../scenarios/paper.toml"   # the base scenario, relative to this file (default: the paper's)
+    seeds = 10                              # seeds 0..9, or a list [3, 7]
+    [grid]                                  # every combination of these scenario keys
+    agents = [1, 2, 4]
+    controller = ["paper", "zigzag"]
+    [fixed]                                 # the same override for every run
+    max_time = 5000.0
+
+writes ``OUT/runs.csv``: one row per run, with every grid key, the seed and every figure of the run's
+summary (completed, completion_time, optimum_time, time_ratio, steps, team_path_length, final_error,
+and the safety figures when robots have a body). Each row is written and flushed as its run ends, so a
+sweep killed at any point loses at most the runs under way; started again on the same OUT it reads the
+table (a last line cut by the kill is dropped), runs only what is missing and says how many it found.
+Locally it uses every core; ``--cluster ADDRESS`` sends the runs to the workers of a running Dask
+distributed scheduler instead (the table is written here). ``anicov sweep-plot`` draws any figure
+against any key.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import math
+import os
+import tomllib
+from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from model.scenario import PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
+
+FIGURES = (
+    "completed",
+    "completion_time",
+    "optimum_time",
+    "time_ratio",
+    "steps",
+    "team_path_length",
+    "final_error",
+    "min_separation",
+    "min_clearance",
+    "filter_active_fraction",
+    "deadlocks",
+)
+"""The summary's figures a row carries (those a run does not have are left empty)."""
+SWEEP_KEYS = ("scenario", "seeds", "grid", "fixed")
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A parsed sweep file: the base scenario, the grid (key → values, in file order), the seeds."""
+
+    base: Scenario
+    grid: dict[str, list[Any]]
+    seeds: list[int]
+    source: Path
+
+    @property
+    def columns(self) -> list[str]:
+        return [*self.grid, "seed", *FIGURES]
+
+    def points(self) -> Iterator[dict[str, Any]]:
+        """Every run's keys: each combination of the grid, for each seed."""
+        names = list(self.grid)
+        for values in itertools.product(*(self.grid[name] for name in names)):
+            for seed in self.seeds:
+                yield dict(zip(names, values, strict=True)) | {"seed": seed}
+
+    def scenario_of(self, point: dict[str, Any]) -> Scenario:
+        return self.base.with_overrides(**point)
+
+
+def load_sweep(path: Path) -> Sweep:
+    """Read and check a sweep file; every error names the key and what was expected."""
+    try:
+        spec = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as error:
+        raise ScenarioError(f"{path}: cannot read the sweep file ({error.strerror})") from None
+    except tomllib.TOMLDecodeError as error:
+        raise ScenarioError(f"{path}: not valid TOML ({error})") from None
+    unknown = sorted(set(spec) - set(SWEEP_KEYS))
+    if unknown:
+        raise ScenarioError(f"{path}: unknown key {unknown[0]!r}; expected keys among {', '.join(SWEEP_KEYS)}")
+    base_path = PAPER_SCENARIO if "scenario" not in spec else path.parent / str(spec["scenario"])
+    base = load_scenario(base_path)
+    fixed = spec.get("fixed", {})
+    if not isinstance(fixed, dict):
+        raise ScenarioError(f"{path}: fixed: expected a table of scenario keys")
+    try:
+        base = base.with_overrides(**fixed)
+    except ScenarioError as error:
+        raise ScenarioError(f"{path}: fixed: {error}") from None
+    grid = spec.get("grid", {})
+    if not isinstance(grid, dict) or not all(isinstance(values, list) and values for values in grid.values()):
+        raise ScenarioError(f"{path}: grid: expected a table of scenario keys, each a non-empty list of values")
+    if "seed" in grid:
+        raise ScenarioError(f"{path}: grid: 'seed' is given by the top-level key seeds")
+    for name, values in grid.items():
+        for value in values:
+            try:
+                base.with_overrides(**{name: value})
+            except ScenarioError as error:
+                raise ScenarioError(f"{path}: grid.{name} = {value!r}: {error}") from None
+    seeds = spec.get("seeds", 1)
+    if isinstance(seeds, int) and not isinstance(seeds, bool) and seeds >= 1:
+        seeds = list(range(seeds))
+    elif not (isinstance(seeds, list) and seeds and all(isinstance(s, int) and not isinstance(s, bool) for s in seeds)):
+        raise ScenarioError(f"{path}: seeds: expected a positive number of seeds or a list of integers")
+    return Sweep(base, grid, list(seeds), path)
+
+
+def run_point(sweep: Sweep, point: dict[str, Any]) -> dict[str, Any]:
+    """One run of the sweep in this process: its row of the table."""
+    from anicov.engine import run_scenario
+    from runtime.rundir import summary_of
+
+    summary = summary_of(run_scenario(sweep.scenario_of(point), record_trace=False))
+    return point | {figure: summary.get(figure) for figure in FIGURES}
+
+
+def _key(point: dict[str, Any], names: list[str]) -> tuple[str, ...]:
+    """A row's identity in the table, as its cells read back from CSV."""
+    return tuple(_cell(point[name]) for name in [*names, "seed"])
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float) and value.is_integer():
+        return repr(value)
+    return str(value)
+
+
+def read_done(table: Path, columns: list[str]) -> list[dict[str, str]]:
+    """The rows a previous run of this sweep wrote; a last line cut short by a kill is left out (and cut
+    from the file, so appending goes on from a whole line)."""
+    if not table.exists():
+        return []
+    text = table.read_text(encoding="utf-8")
+    if not text.endswith("\n"):
+        text = text[: text.rfind("\n") + 1]
+        table.write_text(text, encoding="utf-8")
+    lines = text.splitlines()
+    if not lines:
+        return []
+    header = next(csv.reader([lines[0]]))
+    if header != columns:
+        raise ScenarioError(f"{table}: written by another sweep (its columns differ); give another --out")
+    return [dict(zip(header, row, strict=True)) for row in csv.reader(lines[1:]) if len(row) == len(header)]
+
+
+def run_sweep(
+    sweep: Sweep, out_dir: Path, workers: int | None = None, cluster: str | None = None, progress: bool = True
+) -> tuple[int, int]:
+    """Run what the table lacks; returns (runs found done, runs made now)."""
+    from tqdm import tqdm
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    table = out_dir / "runs.csv"
+    names = list(sweep.grid)
+    done = {tuple(row[name] for name in [*names, "seed"]) for row in read_done(table, sweep.columns)}
+    todo = [point for point in sweep.points() if _key(point, names) not in done]
+    fresh = not table.exists() or table.stat().st_size == 0
+    with open(table, "a", encoding="utf-8", newline="") as sink:
+        writer = csv.writer(sink, lineterminator="\n")
+        if fresh:
+            writer.writerow(sweep.columns)
+            sink.flush()
+        bar = tqdm(total=len(todo), desc="sweep runs", unit="run", disable=not progress)
+        for row in _results(sweep, todo, workers, cluster):
+            writer.writerow([_cell(row[column]) for column in sweep.columns])
+            sink.flush()
+            os.fsync(sink.fileno())
+            bar.update()
+        bar.close()
+    return len(done), len(todo)
+
+
+def _results(
+    sweep: Sweep, todo: list[dict[str, Any]], workers: int | None, cluster: str | None
+) -> Iterator[dict[str, Any]]:
+    """Each run's row as it ends, from this machine's cores or a Dask cluster's workers."""
+    if not todo:
+        return
+    if cluster is not None:
+        from distributed import Client
+        from distributed import as_completed as cluster_completed
+
+        with Client(cluster, timeout="30s") as client:
+            futures = [client.submit(run_point, sweep, point, pure=False) for point in todo]
+            for future in cluster_completed(futures):
+                yield future.result()
+        return
+    with ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
+        pending = [pool.submit(run_point, sweep, point) for point in todo]
+        for future in as_completed(pending):
+            yield future.result()
+
+
+def plot_sweep(out_dir: Path, x: str, y: str, by: str | None, path: Path) -> Path:
+    """Mean of figure ``y`` against key ``x`` (one line per value of ``by``), with its standard deviation."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    table = out_dir / "runs.csv"
+    with open(table, encoding="utf-8") as source:
+        rows = list(csv.DictReader(source))
+    if not rows:
+        raise ScenarioError(f"{table}: no runs yet")
+    for name, what in ((x, "--x"), (y, "--y"), (by, "--by")):
+        if name is not None and name not in rows[0]:
+            raise ScenarioError(f"{what}: expected a column of {table} ({', '.join(rows[0])}), got {name!r}")
+    groups: dict[str, dict[float, list[float]]] = {}
+    for row in rows:
+        if row[y] in ("", "None"):
+            continue  # a run without this figure (not completed: no completion time)
+        series = groups.setdefault(row[by] if by else y, {})
+        series.setdefault(_number(row[x], x), []).append(_number(row[y], y))
+    fig, axes = plt.subplots(figsize=(6.4, 4.2))
+    for label, series in sorted(groups.items()):
+        xs = sorted(series)
+        means = [sum(series[v]) / len(series[v]) for v in xs]
+        spreads = [
+            math.sqrt(sum((s - m) ** 2 for s in series[v]) / len(series[v])) for v, m in zip(xs, means, strict=True)
+        ]
+        axes.errorbar(xs, means, yerr=spreads, marker="o", capsize=3, label=f"{by} = {label}" if by else label)
+    axes.set_xlabel(x)
+    axes.set_ylabel(f"{y} (mean ± sd over seeds)")
+    axes.grid(alpha=0.3)
+    axes.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def _number(text: str, column: str) -> float:
+    if text in ("True", "False"):
+        return float(text == "True")
+    try:
+        return float(text)
+    except ValueError:
+        raise ScenarioError(f"column {column!r} holds {text!r}, not a number: plot it with --by instead") from None

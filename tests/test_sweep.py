@@ -1,0 +1,128 @@
+"""anicov sweep: a grid of runs into one table that resumes where it stopped, locally or on a Dask cluster."""
+
+from __future__ import annotations
+
+import csv
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from anicov.sweep import load_sweep, run_sweep
+from model.scenario import ScenarioError
+from tests.teamrun import ROOT, wait_for
+
+SMALL = """
+seeds = {seeds}
+[grid]
+agents = [1, 2]
+controller = ["paper", "zigzag"]
+[fixed]
+domain = [24.0, 24.0]
+range = 8.0
+"""
+
+
+def write_sweep(tmp_path, seeds: int = 2, text: str = SMALL):
+    path = tmp_path / "sweep.toml"
+    path.write_text(text.format(seeds=seeds))
+    return path
+
+
+def rows_of(out) -> list[dict[str, str]]:
+    with open(out / "runs.csv") as source:
+        return list(csv.DictReader(source))
+
+
+def test_every_point_of_the_grid_is_one_row_with_the_runs_figures(tmp_path):
+    sweep = load_sweep(write_sweep(tmp_path))
+    assert run_sweep(sweep, tmp_path / "out", workers=1, progress=False) == (0, 8)
+    rows = rows_of(tmp_path / "out")
+    assert sorted((r["agents"], r["controller"], r["seed"]) for r in rows) == sorted(
+        (a, c, s) for a in "12" for c in ("paper", "zigzag") for s in "01"
+    )
+    assert all(r["completed"] == "True" and float(r["time_ratio"]) > 1.0 for r in rows)
+    # The same point gives the same row: the runs are seeded.
+    again = run_sweep(sweep, tmp_path / "again", workers=2, progress=False)
+    assert again == (0, 8)
+    assert sorted(map(str, rows)) == sorted(map(str, rows_of(tmp_path / "again")))
+
+
+def test_a_stopped_sweep_runs_only_what_it_lacks_and_drops_a_cut_line(tmp_path):
+    sweep = load_sweep(write_sweep(tmp_path))
+    out = tmp_path / "out"
+    run_sweep(sweep, out, workers=1, progress=False)
+    lines = (out / "runs.csv").read_text().splitlines(keepends=True)
+    (out / "runs.csv").write_text("".join(lines[:4]) + lines[4][:11])  # three rows whole, a fourth cut by a kill
+    assert run_sweep(sweep, out, workers=1, progress=False) == (3, 5)
+    assert len(rows_of(out)) == 8 and len({tuple(r.values()) for r in rows_of(out)}) == 8
+
+
+def test_a_killed_sweep_process_loses_nothing_and_resumes(tmp_path):
+    """SIGKILL to the sweep and its workers mid-way; started again it makes only the rest."""
+    path = write_sweep(tmp_path, seeds=8)
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "anicov.cli", "sweep", str(path), "--out", str(out), "--workers", "2", "--quiet"]
+    process = subprocess.Popen(command, cwd=ROOT, start_new_session=True, stdout=subprocess.PIPE, text=True)
+    try:
+        assert wait_for(lambda: (out / "runs.csv").exists() and len(rows_of(out)) >= 4, timeout=240)
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.communicate()
+    kept = len(rows_of(out))
+    assert 4 <= kept < 32
+    again = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert again.returncode == 0, again.stderr
+    assert f"32 runs; {kept} found done" in again.stdout
+    rows = rows_of(out)
+    assert len(rows) == 32 and len({(r["agents"], r["controller"], r["seed"]) for r in rows}) == 32
+
+
+def test_the_same_sweep_on_a_dask_cluster_started_here(tmp_path):
+    from distributed import LocalCluster
+
+    path = write_sweep(tmp_path, seeds=1)
+    local = tmp_path / "local"
+    run_sweep(load_sweep(path), local, workers=1, progress=False)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        started = time.monotonic()
+        done = subprocess.run(
+            [sys.executable, "-m", "anicov.cli", "sweep", str(path), "--out", str(tmp_path / "cluster"), "--quiet",
+             "--cluster", cluster.scheduler_address],
+            cwd=ROOT, capture_output=True, text=True, timeout=600,
+        )  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        assert time.monotonic() - started < 600
+    assert f"on the cluster at {cluster.scheduler_address}" in done.stdout
+    assert sorted(map(str, rows_of(tmp_path / "cluster"))) == sorted(map(str, rows_of(local)))
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("seeds = 2\ncolour = 1\n", "unknown key 'colour'"),
+        ("[grid]\nagents = [1, -3]\n", "grid.agents = -3"),
+        ("[grid]\nwingspan = [1]\n", "grid.wingspan"),
+        ("[grid]\nagents = []\n", "non-empty list"),
+        ("seeds = 0\n", "seeds: expected"),
+        ("[fixed]\nrange = -1.0\n", "fixed: "),
+        ("[grid]\nseed = [1, 2]\n", "'seed' is given by the top-level key seeds"),
+        ("scenario = 'nowhere.toml'\n", "nowhere.toml"),
+    ],
+)
+def test_a_bad_sweep_file_is_a_clear_error(tmp_path, text, message):
+    with pytest.raises(ScenarioError, match=message.replace("(", r"\(").replace(".", r"\.")):
+        load_sweep(write_sweep(tmp_path, text=text))
+
+
+def test_a_plot_of_any_figure_against_any_key(tmp_path):
+    from anicov.sweep import plot_sweep
+
+    run_sweep(load_sweep(write_sweep(tmp_path)), tmp_path / "out", workers=1, progress=False)
+    png = plot_sweep(tmp_path / "out", "agents", "team_path_length", "controller", tmp_path / "p.png")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(ScenarioError, match="--y: expected a column"):
+        plot_sweep(tmp_path / "out", "agents", "speed", None, tmp_path / "q.png")
