@@ -28,7 +28,7 @@ from model.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move, sense_only
 from model.world import World, world_of
-from model.zigzag import zigzag_pilots
+from model.zigzag import boustrophedon_pilots, zigzag_pilots
 
 
 @njit(cache=True)
@@ -102,7 +102,7 @@ def run_scenario(
     """Run one team to full coverage or ``max_time`` in this process."""
     coverage_map = coverage_map_of(scenario)
     poses = starting_poses(scenario) if poses is None else np.array(poses, dtype=np.float64)
-    if scenario.controller == "zigzag":
+    if scenario.controller in ("zigzag", "boustrophedon"):
         return _run_zigzag(scenario, coverage_map, poses, record_trace, progress)
     law, world = law_parameters(scenario, coverage_map), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
@@ -207,7 +207,9 @@ def _run_zigzag(
     """The zig-zag baseline: each agent flies its lanes; the run lasts until every plan is done."""
     law = law_parameters(scenario, coverage_map)
     ground, nobody = open_ground(), np.zeros((0, 2))
-    pilots = zigzag_pilots(scenario)
+    pilots = (
+        boustrophedon_pilots(scenario, poses) if scenario.controller == "boustrophedon" else zigzag_pilots(scenario)
+    )
     rows_out: list[np.ndarray] = []
     errors = [coverage_map.domain_error()]
     snapshot_times, snapshots = [0.0], [quantised_lack(coverage_map.lack_of_coverage())]

@@ -16,9 +16,11 @@ from model.scenario_safety import SAFETY_DEFAULTS, SafetyKeyError, check_safety,
 from model.scenario_terrain import resolve_terrain_keys
 from model.terrain import TerrainError
 
-CONTROLLERS = ("paper", "paper-literal", "paper-eq16", "zigzag")
+CONTROLLERS = ("paper", "paper-literal", "paper-eq16", "zigzag", "boustrophedon")
 """``paper``: the chosen readings of eq. 11 and 16; ``paper-literal``: both as printed; ``paper-eq16``: eq. 11
-read toward the objective but eq. 16 as printed; ``zigzag``: Fig. 8 (docs/paper-notes.md)."""
+read toward the objective but eq. 16 as printed; ``zigzag``: Fig. 8 (docs/paper-notes.md), the lanes split in
+contiguous blocks; ``boustrophedon``: the same path cut into N pieces of equal length, each flown by the robot
+whose start is nearest in the team's least total transit (:func:`model.zigzag.boustrophedon_pilots`)."""
 
 
 PAPER_SCENARIO = Path(__file__).resolve().parent.parent / "scenarios" / "paper.toml"
@@ -207,9 +209,9 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
 
 def _check_whole(scenario: Scenario) -> Scenario:
     """The checks that read several keys at once."""
-    if scenario.controller == "zigzag" and scenario.has_terrain:
+    if scenario.controller in ("zigzag", "boustrophedon") and scenario.has_terrain:
         raise ScenarioError(
-            "scenario key 'controller': 'zigzag' flies the open domain's lanes and knows no walls or robot "
+            f"scenario key 'controller': '{scenario.controller}' flies the open domain's lanes and knows no walls or robot "
             "bodies; with map, obstacles or robot_radius use one of paper, paper-literal, paper-eq16"
         )
     if scenario.map and scenario.metres_per_unit != 1.0:

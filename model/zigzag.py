@@ -93,6 +93,52 @@ def zigzag_pilots(scenario: Scenario) -> list[WaypointPilot]:
     return pilots
 
 
+def path_between(waypoints: np.ndarray, start: float, end: float) -> np.ndarray:
+    """The stretch of a polyline between two distances along it (start < end), as a polyline."""
+    along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1))])
+    inner = waypoints[(along > start) & (along < end)]
+    return np.vstack([_point_at(waypoints, along, start), inner, _point_at(waypoints, along, end)])
+
+
+def _point_at(waypoints: np.ndarray, along: np.ndarray, distance: float) -> np.ndarray:
+    segment = min(int(np.searchsorted(along, distance, side="right")) - 1, len(waypoints) - 2)
+    share = (distance - along[segment]) / max(along[segment + 1] - along[segment], 1e-300)
+    return waypoints[segment] + share * (waypoints[segment + 1] - waypoints[segment])
+
+
+def boustrophedon_pilots(scenario: Scenario, poses: np.ndarray) -> list[WaypointPilot]:
+    """The zig-zag for N robots from anywhere (``controller = "boustrophedon"``): the one-robot path of
+    Fig. 8 (lanes d100 from the edges, at most 2·d50 apart: both from eq. 2) cut into N pieces of equal
+    length, each robot given the piece whose nearer end it reaches with the least total transit for the
+    team (scipy's linear_sum_assignment), flown from that end. A piece that starts at a cut starts R
+    earlier along the path: a point is swept by the whole wedge only once the robot has come R toward
+    it, so without the overlap the first R of each piece would be seen only in part."""
+    from scipy.optimize import linear_sum_assignment
+
+    d100 = coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
+    d50 = coverage_distance(scenario.lambda_star / 2.0, scenario.range, scenario.half_angle, scenario.alpha_max)
+    lanes = lane_offsets(scenario.domain[1], d100, 2.0 * d50)
+    path = zigzag_waypoints(scenario.domain[0], lanes, scenario.range, 0)
+    along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
+    cuts = np.linspace(0.0, along[-1], scenario.agents + 1)
+    firsts = np.array([_point_at(path, along, cut) for cut in cuts[:-1]])
+    lasts = np.array([_point_at(path, along, cut) for cut in cuts[1:]])
+    starts = np.asarray(poses)[:, :2]
+    to_first = np.linalg.norm(starts[:, None, :] - firsts[None], axis=2)
+    to_last = np.linalg.norm(starts[:, None, :] - lasts[None], axis=2)
+    robots, chosen = linear_sum_assignment(np.minimum(to_first, to_last))
+    pilots: list[WaypointPilot] = [None] * scenario.agents  # type: ignore[list-item]
+    for robot, piece in zip(robots, chosen, strict=True):
+        low, high = cuts[piece], cuts[piece + 1]
+        if to_first[robot, piece] <= to_last[robot, piece]:
+            waypoints = path_between(path, max(low - scenario.range, 0.0) if piece > 0 else low, high)
+        else:
+            last = piece == scenario.agents - 1
+            waypoints = path_between(path, low, min(high + scenario.range, along[-1]) if not last else high)[::-1]
+        pilots[robot] = WaypointPilot(waypoints.copy(), scenario.k_v, scenario.k_omega * math.pi / 2.0, scenario.dt)
+    return pilots
+
+
 def zigzag_start_poses(scenario: Scenario) -> np.ndarray:
     """Poses at the start of each agent's first lane, facing along it."""
     poses = []

@@ -25,7 +25,7 @@ def add_scenario_arguments(parser: argparse.ArgumentParser, controllers: tuple[s
 
 def add_team_arguments(parser: argparse.ArgumentParser) -> None:
     """The scenario arguments of a team on the bus (no zig-zag there), and its clock."""
-    add_scenario_arguments(parser, tuple(c for c in CONTROLLERS if c != "zigzag"))
+    add_scenario_arguments(parser, tuple(c for c in CONTROLLERS if c not in ("zigzag", "boustrophedon")))
     parser.add_argument(
         "--clock",
         choices=CLOCKS,
