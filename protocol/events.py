@@ -32,13 +32,14 @@ def as_event(delta: MapDelta, pose: Pose, kernel: ExactKernel | None) -> MapDelt
         return delta
     row0, col0, exact = event_ticks(kernel, *pose)
     height, width = exact.shape
-    top, left = delta.row0 - row0, delta.col0 - col0
-    bottom, right = top + delta.ticks.shape[0], left + delta.ticks.shape[1]
-    inside = delta.ticks[max(-top, 0) : height - top, max(-left, 0) : width - left]
+    top, left = delta.row0 - row0, delta.col0 - col0  # the sender's window in the kernel's
+    rows = slice(max(top, 0), max(min(top + delta.ticks.shape[0], height), max(top, 0)))
+    cols = slice(max(left, 0), max(min(left + delta.ticks.shape[1], width), max(left, 0)))
+    inside = delta.ticks[rows.start - top : rows.stop - top, cols.start - left : cols.stop - left]
     if int(inside.sum()) != int(delta.ticks.sum()):  # the sender's ticks reach outside the kernel's window
         return delta
     sent = np.zeros_like(exact)
-    sent[max(top, 0) : min(bottom, height), max(left, 0) : min(right, width)] = inside
+    sent[rows, cols] = inside
     differ = np.flatnonzero(sent != exact)
     if 2 * differ.size > exact.size:
         return delta

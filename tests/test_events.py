@@ -103,3 +103,14 @@ def test_a_team_without_a_kernel_refuses_events():
         decode(event_body(), Limits(100, 100, 4))
     assert caught.value.reason == "no-kernel"
     assert decode(event_body(fix=[0, 7]), Limits.of(PAPER)).ticks.reshape(-1)[0] == 7
+
+
+def test_a_delta_reaching_outside_the_kernels_window_stays_cells():
+    """Only a sender whose ticks the kernel cannot place travels as cells (here: a made-up far window)."""
+    limits = Limits.of(PAPER)
+    pose, delta = next(sensed_deltas(PAPER, 1, seed=3))
+    far = MapDelta(1, 0, 90, 90, np.ones((3, 3), np.int64))
+    assert as_event(far, (10.0, 10.0, 0.0), limits.kernel) is far
+    shifted = MapDelta(1, 0, delta.row0, delta.col0, np.pad(delta.ticks, ((0, 0), (0, 1)), constant_values=1))
+    edge = as_event(shifted, pose, limits.kernel)
+    assert edge is shifted or (placed(edge, PAPER.grid_shape) == placed(shifted, PAPER.grid_shape)).all()
