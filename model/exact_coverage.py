@@ -15,7 +15,8 @@ multiplications that never overflow, and nothing else after the event's numbers 
 3. Each cell centre in the robot's frame, (along, across) = K·R(−θ)·(c − p): CORDIC rotation (Volder 1959)
    by −θ of the window's first centre and of one column and one row step, ``ITERATIONS`` shift-and-add
    steps each; every other centre by adding steps (exact). Positions in Q``p`` (``p`` from R: no overflow).
-4. φ = |θ_i − θ_x| and r: CORDIC vectoring of (along, |across|), which leaves K²·r and the angle.
+4. φ = |θ_i − θ_x| and r: CORDIC vectoring of (along, |across|), 20 steps, then the angle left taken as
+   y/x and the length as x + y²/(2x) (both within 1e-17), one integer division.
    A centre within 2⁻⁴⁵ units of the robot is under it: r = φ = 0 (eq. 2 leaves θ_ix undefined there; the
    float kernel takes 0 too).
 5. In the wedge (r ≤ R and φ ≤ F), ticks = ⌊C·(R − r)·(F − φ) + ½⌋ as in eq. 2–3, with the products taken
@@ -95,8 +96,11 @@ ATAN_Q60 = np.array(
 with the platform's libm, so every machine holds the same table)."""
 PI_Q60 = 3622009729038561421
 """π in Q60."""
-INV_K2_Q62 = 1700587475449975444
-"""2⁶²/K², K = Π sqrt(1 + 4⁻ⁱ) the CORDIC gain (rotation and vectoring each scale by K)."""
+INV_K2_Q62 = 1700587475451006561
+"""2⁶²/(K₄₄·K₂₀), K_n = Π_{i<n} sqrt(1 + 4⁻ⁱ) the CORDIC gain of n steps: rotation takes 44, vectoring 20
+(60-digit decimal products, written out)."""
+VECTOR_ITERATIONS = 20
+"""Vectoring steps; the angle left, below 2⁻¹⁹, is then taken as y/x (its cube, under 1e-17 rad, dropped)."""
 
 POSITION_BITS = 40
 """Absolute positions in Q40: domains up to 2²² units on a side."""
@@ -205,14 +209,23 @@ def _directions(angle_q60: int) -> np.ndarray:
 
 @njit(cache=True)
 def _vector(along: int, across: int) -> tuple[int, int]:
-    """(K·|(along, across)|, atan2(across, along)) for across ≥ 0 and along ≥ 0, angle in Q60."""
+    """(K₂₀·|(along, across)|, atan2(across, along)) for across ≥ 0 and along ≥ 0, angle in Q60.
+
+    VECTOR_ITERATIONS steps leave (x, y) with |y/x| < 2⁻¹⁹; then atan(y/x) ≈ y/x and |(x, y)| ≈ x + y²/(2x),
+    each within 1e-17 of its value: t = y/x in Q40 by one division of 62-bit integers."""
     x, y, z = along, across, 0
-    for i in range(ITERATIONS):
+    for i in range(VECTOR_ITERATIONS):
         if y > 0:
             x, y, z = x + (y >> i), y - (x >> i), z + ATAN_Q60[i]
         else:
             x, y, z = x - (y >> i), y + (x >> i), z - ATAN_Q60[i]
-    return x, z
+    if x <= 0:
+        return 0, z
+    scale = x >> 20
+    if scale == 0:  # a vector this short (under 2⁻³⁵ units) is at the robot: no angle left to refine
+        return x, z
+    ratio = (y << 20) // scale  # y/x in Q40 (|y| < 2⁴² so y·2²⁰ fits)
+    return x + ((y * (ratio >> 10)) >> 31), z + (ratio << 20)
 
 
 @njit(cache=True)

@@ -70,7 +70,10 @@ def test_each_robot_gets_the_piece_that_keeps_the_teams_transit_least(paper_scen
     chosen = sum(np.linalg.norm(pilot.waypoints[0] - poses[i, :2]) for i, pilot in enumerate(pilots))
     starts = [pilot.waypoints[0] for pilot in pilots] + [pilot.waypoints[-1] for pilot in pilots]
     best = min(
-        sum(min(np.linalg.norm(poses[i, :2] - starts[p]), np.linalg.norm(poses[i, :2] - starts[p + 3])) for i, p in enumerate(order))
+        sum(
+            min(np.linalg.norm(poses[i, :2] - starts[p]), np.linalg.norm(poses[i, :2] - starts[p + 3]))
+            for i, p in enumerate(order)
+        )
         for order in permutations(range(3))
     )
     assert chosen <= best + 3 * scenario.range  # a piece's start may lie R back along the path from its cut
