@@ -116,9 +116,10 @@ def command_sweep(args: argparse.Namespace) -> int:
 
 
 def command_sweep_plot(args: argparse.Namespace) -> int:
-    from anicov.sweep import plot_sweep
+    from anicov.sweep import mean_table, plot_sweep
 
     path = Path(args.png) if args.png else Path(args.out) / f"{args.y}_by_{args.x}.png"
+    print(mean_table(Path(args.out), args.x, args.y, args.by))
     print(f"plot written to {plot_sweep(Path(args.out), args.x, args.y, args.by, path)}")
     return EXIT_OK
 
@@ -234,7 +235,9 @@ def _add_sweep(commands: argparse._SubParsersAction) -> None:
     sweep.add_argument("--quiet", action="store_true", help="no progress bar")
     sweep.set_defaults(handler=command_sweep)
 
-    plot = commands.add_parser("sweep-plot", help="a figure of a sweep's table against one of its keys (PNG)")
+    plot = commands.add_parser(
+        "sweep-plot", help="a figure of a sweep's table against one of its keys: its means (markdown) and a PNG"
+    )
     plot.add_argument("out", help="the sweep's output directory")
     plot.add_argument("--x", required=True, help="the key on the x axis, e.g. agents")
     plot.add_argument("--y", required=True, help="the figure on the y axis, e.g. time_ratio")

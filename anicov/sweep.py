@@ -204,13 +204,8 @@ def _results(
             yield future.result()
 
 
-def plot_sweep(out_dir: Path, x: str, y: str, by: str | None, path: Path) -> Path:
-    """Mean of figure ``y`` against key ``x`` (one line per value of ``by``), with its standard deviation."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def grouped(out_dir: Path, x: str, y: str, by: str | None) -> dict[str, dict[float, list[float]]]:
+    """Figure ``y`` of every run that has it, by value of ``by`` (one group without it) and of key ``x``."""
     table = out_dir / "runs.csv"
     with open(table, encoding="utf-8") as source:
         rows = list(csv.DictReader(source))
@@ -225,6 +220,34 @@ def plot_sweep(out_dir: Path, x: str, y: str, by: str | None, path: Path) -> Pat
             continue  # a run without this figure (not completed: no completion time)
         series = groups.setdefault(row[by] if by else y, {})
         series.setdefault(_number(row[x], x), []).append(_number(row[y], y))
+    return groups
+
+
+def mean_table(out_dir: Path, x: str, y: str, by: str | None) -> str:
+    """A markdown table of the mean of ``y`` (and how many runs had it) per value of ``x``, a column per ``by``."""
+    groups = grouped(out_dir, x, y, by)
+    labels = sorted(groups)
+    xs = sorted({value for series in groups.values() for value in series})
+    lines = [f"| {x} | " + " | ".join(f"{label} (runs)" for label in labels) + " |", "|---" * (len(labels) + 1) + "|"]
+    for value in xs:
+        cells = [
+            f"{sum(groups[label][value]) / len(groups[label][value]):.3f} ({len(groups[label][value])})"
+            if value in groups[label]
+            else "-"
+            for label in labels
+        ]
+        lines.append(f"| {value:g} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def plot_sweep(out_dir: Path, x: str, y: str, by: str | None, path: Path) -> Path:
+    """Mean of figure ``y`` against key ``x`` (one line per value of ``by``), with its standard deviation."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    groups = grouped(out_dir, x, y, by)
     fig, axes = plt.subplots(figsize=(6.4, 4.2))
     for label, series in sorted(groups.items()):
         xs = sorted(series)

@@ -119,9 +119,14 @@ def test_a_bad_sweep_file_is_a_clear_error(tmp_path, text, message):
 
 
 def test_a_plot_of_any_figure_against_any_key(tmp_path):
-    from anicov.sweep import plot_sweep
+    from anicov.sweep import mean_table, plot_sweep
 
     run_sweep(load_sweep(write_sweep(tmp_path)), tmp_path / "out", workers=1, progress=False)
+    rows = rows_of(tmp_path / "out")
+    table = mean_table(tmp_path / "out", "agents", "steps", "controller").splitlines()
+    assert table[0] == "| agents | paper (runs) | zigzag (runs) |"
+    paper_one = [int(r["steps"]) for r in rows if r["controller"] == "paper" and r["agents"] == "1"]
+    assert table[2].startswith(f"| 1 | {sum(paper_one) / 2:.3f} (2) |")
     png = plot_sweep(tmp_path / "out", "agents", "team_path_length", "controller", tmp_path / "p.png")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     with pytest.raises(ScenarioError, match="--y: expected a column"):
