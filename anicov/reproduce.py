@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from anicov.engine import run_scenario
+from anicov.sweep import Sweep, read_done, run_sweep
 from model.metrics import coverage_distance, optimum_time, straight_pass_coverage, total_sensing_ability
 from model.scenario import PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
 from model.zigzag import zigzag_pilots, zigzag_start_poses
@@ -56,11 +55,6 @@ def paper_curve(agents: int) -> float:
     return 4.0 + (agents - 1) / 29.0
 
 
-def _one_run(scenario: Scenario) -> tuple[int, int, bool, float, float]:
-    result = run_scenario(scenario, record_trace=False)
-    return scenario.agents, scenario.seed, result.completed, result.completion_time, float(result.path_lengths.sum())
-
-
 def zigzag_reference(base: Scenario) -> dict[str, Any]:
     """One agent flying the Fig. 8 plan from its start: time and path to the plan's end."""
     scenario = base.with_overrides(controller="zigzag", agents=1)
@@ -78,23 +72,23 @@ def reproduce(
     out_dir: Path, runs: int, teams: list[int], workers: int | None = None, seed: int = 0, base: Scenario | None = None
 ) -> dict[str, Any]:
     """Run the experiments and write every output; returns the reproduction.json content."""
-    from tqdm import tqdm
 
     out_dir.mkdir(parents=True, exist_ok=True)
     base = load_scenario(PAPER_SCENARIO) if base is None else base
     ability = total_sensing_ability(base.range, base.half_angle, base.alpha_max)
     area = base.domain[0] * base.domain[1]
     zigzag = zigzag_reference(base)
-    tasks = [base.with_overrides(agents=n, seed=seed + r, controller="paper") for n in teams for r in range(runs)]
-    # Biggest jobs first (one agent runs longest) keeps the pool busy to the end.
-    tasks.sort(key=lambda scenario: scenario.agents)
+    # One anicov sweep (anicov.sweep): its table OUT/runs.csv is kept, so a reproduction stopped half-way
+    # resumes where it stopped. Team sizes in order, one agent (the longest runs) first.
+    sweep = Sweep(base.with_overrides(controller="paper"), {"agents": teams}, [seed + r for r in range(runs)], out_dir)
+    run_sweep(sweep, out_dir, workers)
     outcomes: dict[int, list[tuple[int, bool, float, float]]] = {n: [] for n in teams}
-    workers = workers or os.cpu_count() or 1
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(_one_run, task) for task in tasks]
-        for future in tqdm(as_completed(futures), total=len(futures), desc="reproduction runs", unit="run"):
-            agents, run_seed, completed, time, path = future.result()
-            outcomes[agents].append((run_seed, completed, time, path))
+    for row in read_done(out_dir / "runs.csv", sweep.columns):
+        if int(row["agents"]) not in outcomes or int(row["seed"]) not in sweep.seeds:
+            continue  # an earlier reproduction in this directory with other team sizes or seeds
+        completed = row["completed"] == "True"
+        time, path = float(row["completion_time"] or "nan"), float(row["team_path_length"])
+        outcomes[int(row["agents"])].append((int(row["seed"]), completed, time, path))
     for results in outcomes.values():
         results.sort()  # by seed: the means must not depend on which run finished first
     rows = []

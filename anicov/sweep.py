@@ -163,6 +163,7 @@ def run_sweep(
     from tqdm import tqdm
 
     out_dir.mkdir(parents=True, exist_ok=True)
+    _check_same_base(sweep, out_dir)
     table = out_dir / "runs.csv"
     names = list(sweep.grid)
     done = {tuple(row[name] for name in [*names, "seed"]) for row in read_done(table, sweep.columns)}
@@ -181,6 +182,20 @@ def run_sweep(
             bar.update()
         bar.close()
     return len(done), len(todo)
+
+
+def _check_same_base(sweep: Sweep, out_dir: Path) -> None:
+    """OUT/sweep.json holds the base scenario (the fixed keys included) whose runs the table holds: a row
+    is reused only for the same base, so a sweep resumed with other fixed keys is refused, not mixed."""
+    import json
+
+    record = out_dir / "sweep.json"
+    base = sweep.base.to_dict()
+    if record.exists():
+        if json.loads(record.read_text(encoding="utf-8")).get("base") != json.loads(json.dumps(base)):
+            raise ScenarioError(f"{out_dir}: holds runs of another base scenario or fixed keys; give another --out")
+        return
+    record.write_text(json.dumps({"base": base}, indent=1) + "\n", encoding="utf-8")
 
 
 def _results(

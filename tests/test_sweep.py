@@ -61,6 +61,13 @@ def test_a_stopped_sweep_runs_only_what_it_lacks_and_drops_a_cut_line(tmp_path):
     assert len(rows_of(out)) == 8 and len({tuple(r.values()) for r in rows_of(out)}) == 8
 
 
+def test_a_sweep_resumed_with_other_fixed_keys_is_refused(tmp_path):
+    run_sweep(load_sweep(write_sweep(tmp_path, seeds=1)), tmp_path / "out", workers=1, progress=False)
+    changed = write_sweep(tmp_path, seeds=1, text=SMALL.replace("range = 8.0", "range = 9.0"))
+    with pytest.raises(ScenarioError, match="another base scenario"):
+        run_sweep(load_sweep(changed), tmp_path / "out", workers=1, progress=False)
+
+
 def test_a_killed_sweep_process_loses_nothing_and_resumes(tmp_path):
     """SIGKILL to the sweep and its workers mid-way; started again it makes only the rest."""
     path = write_sweep(tmp_path, seeds=8)
