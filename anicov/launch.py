@@ -358,7 +358,7 @@ def report(
     logs = out_dir / "logs"
     summary_path = out_dir / "summary.json"
     if seen.exit_code in (EXIT_OK, EXIT_INCOMPLETE) and summary_path.exists():
-        from runtime.rundir import bandwidth_of, format_bandwidth, format_summary
+        from runtime.rundir import bandwidth_of, format_bandwidth, format_summary, read_counts
 
         summary = json.loads(summary_path.read_text())
         print(format_summary(summary, out_dir).replace("anicov run:", f"launch_team ({args.clock}, over Zenoh):"))
@@ -374,7 +374,9 @@ def report(
             print(
                 f"  coordinator     killed and restarted {seen.restarts} time(s); it resumed from the agents' histories"
             )
-        agent_counts = [json.loads(path.read_text()) for path in sorted(logs.glob("agent-*.counts.json"))]
+        agent_counts = [
+            counts for agent in range(agents) if (counts := read_counts(logs / f"agent-{agent}.counts.json"))
+        ]
         bandwidth = bandwidth_of(agent_counts, summary["scenario"]["dt"])
         if bandwidth is not None:
             (out_dir / "bandwidth.json").write_text(json.dumps(bandwidth | {"deltas": args.deltas}, indent=2) + "\n")

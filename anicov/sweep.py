@@ -34,6 +34,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from model.scenario import PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
 
 FIGURES = (
@@ -103,11 +105,14 @@ def load_sweep(path: Path) -> Sweep:
     if "seed" in grid:
         raise ScenarioError(f"{path}: grid: 'seed' is given by the top-level key seeds")
     for name, values in grid.items():
-        for value in values:
+        for index, value in enumerate(values):
             try:
-                base.with_overrides(**{name: value})
+                # As the scenario holds it (20 and 20.0 are one range), so a resumed sweep finds its rows.
+                values[index] = _plain(getattr(base.with_overrides(**{name: value}), name, value))
             except ScenarioError as error:
                 raise ScenarioError(f"{path}: grid.{name} = {value!r}: {error}") from None
+        if len({_cell(value) for value in values}) != len(values):
+            raise ScenarioError(f"{path}: grid.{name}: a value is given twice")
     seeds = spec.get("seeds", 1)
     if isinstance(seeds, int) and not isinstance(seeds, bool) and seeds >= 1:
         seeds = list(range(seeds))
@@ -121,7 +126,9 @@ def run_point(sweep: Sweep, point: dict[str, Any]) -> dict[str, Any]:
     from anicov.engine import run_scenario
     from runtime.rundir import summary_of
 
-    summary = summary_of(run_scenario(sweep.scenario_of(point), record_trace=False))
+    scenario = sweep.scenario_of(point)
+    # The safety figures read the whole trace (robots with a body); the rest need only the path lengths.
+    summary = summary_of(run_scenario(scenario, record_trace=scenario.robot_radius > 0.0))
     return point | {figure: summary.get(figure) for figure in FIGURES}
 
 
@@ -130,11 +137,21 @@ def _key(point: dict[str, Any], names: list[str]) -> tuple[str, ...]:
     return tuple(_cell(point[name]) for name in [*names, "seed"])
 
 
+def _plain(value: Any) -> Any:
+    """A scenario value as plain Python (tuples as lists), for the table and for TOML-like comparison."""
+    return [_plain(item) for item in value] if isinstance(value, tuple | list) else value
+
+
 def _cell(value: Any) -> str:
+    """A value as the table writes it (and a resumed sweep compares it): floats by repr, exactly."""
     if value is None:
         return ""
-    if isinstance(value, float) and value.is_integer():
-        return repr(value)
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, float | np.floating):
+        return repr(float(value))
+    if isinstance(value, int | np.integer):
+        return str(int(value))
     return str(value)
 
 
@@ -144,9 +161,9 @@ def read_done(table: Path, columns: list[str]) -> list[dict[str, str]]:
     if not table.exists():
         return []
     text = table.read_text(encoding="utf-8")
-    if not text.endswith("\n"):
+    if not text.endswith("\n"):  # cut the partial line in place (a rewrite killed half-way would lose all)
         text = text[: text.rfind("\n") + 1]
-        table.write_text(text, encoding="utf-8")
+        os.truncate(table, len(text.encode("utf-8")))
     lines = text.splitlines()
     if not lines:
         return []
@@ -175,12 +192,18 @@ def run_sweep(
             writer.writerow(sweep.columns)
             sink.flush()
         bar = tqdm(total=len(todo), desc="sweep runs", unit="run", disable=not progress)
+        failed: list[str] = []
         for row in _results(sweep, todo, workers, cluster):
-            writer.writerow([_cell(row[column]) for column in sweep.columns])
-            sink.flush()
-            os.fsync(sink.fileno())
+            if isinstance(row, str):
+                failed.append(row)
+            else:
+                writer.writerow([_cell(row[column]) for column in sweep.columns])
+                sink.flush()
+                os.fsync(sink.fileno())
             bar.update()
         bar.close()
+    if failed:
+        raise ScenarioError(f"{len(failed)} run(s) failed, the others are in {table}; first: {failed[0]}")
     return len(done), len(todo)
 
 
@@ -200,8 +223,9 @@ def _check_same_base(sweep: Sweep, out_dir: Path) -> None:
 
 def _results(
     sweep: Sweep, todo: list[dict[str, Any]], workers: int | None, cluster: str | None
-) -> Iterator[dict[str, Any]]:
-    """Each run's row as it ends, from this machine's cores or a Dask cluster's workers."""
+) -> Iterator[dict[str, Any] | str]:
+    """Each run's row as it ends, from this machine's cores or a Dask cluster's workers (a run that
+    raised: what it was and why, so the others are still written)."""
     if not todo:
         return
     if cluster is not None:
@@ -210,13 +234,22 @@ def _results(
 
         with Client(cluster, timeout="30s") as client:
             futures = [client.submit(run_point, sweep, point, pure=False) for point in todo]
+            for future, point in zip(futures, todo, strict=True):
+                future.point = point  # type: ignore[attr-defined]
             for future in cluster_completed(futures):
-                yield future.result()
+                yield _outcome(future, future.point)  # type: ignore[attr-defined]
         return
     with ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
-        pending = [pool.submit(run_point, sweep, point) for point in todo]
+        pending = {pool.submit(run_point, sweep, point): point for point in todo}
         for future in as_completed(pending):
-            yield future.result()
+            yield _outcome(future, pending[future])
+
+
+def _outcome(future: Any, point: dict[str, Any]) -> dict[str, Any] | str:
+    try:
+        return future.result()
+    except Exception as error:  # one bad point must not lose the rest of the sweep
+        return f"{point}: {type(error).__name__}: {error}"
 
 
 def grouped(out_dir: Path, x: str, y: str, by: str | None) -> dict[str, dict[float, list[float]]]:

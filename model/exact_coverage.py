@@ -103,14 +103,15 @@ VECTOR_ITERATIONS = 20
 """Vectoring steps; the angle left, below 2⁻¹⁹, is then taken as y/x (its cube, under 1e-17 rad, dropped)."""
 
 POSITION_BITS = 40
-"""Absolute positions in Q40: domains up to 2²² units on a side."""
+"""Absolute positions in Q40 (domains and ranges up to 2²⁰ units: :func:`exact_kernel` refuses more)."""
 TICK_BITS = 20
 """Ticks are computed in Q20 and then rounded to the nearest tick."""
 LIMB = 31
 TWO_TO_40, TWO_TO_60 = float(2**40), float(2**60)
+COARSE_SHIFT = 33
 CONE_SLACK = 1 << 36
-"""The cone pre-test's slack: Q24 coordinates times Q30 constants err by under 2³², a cell it rejects lies
-more than 2⁻¹⁸/r rad outside the wedge."""
+"""The cone pre-test's slack: coarse coordinates times Q30 constants err by under 2³², so a cell it rejects
+lies well outside the wedge (more than 2⁶·2^(33 − p)/r rad)."""
 
 
 class ExactKernel(NamedTuple):
@@ -224,7 +225,7 @@ def _vector(along: int, across: int) -> tuple[int, int]:
     scale = x >> 20
     if scale == 0:  # a vector this short (under 2⁻³⁵ units) is at the robot: no angle left to refine
         return x, z
-    ratio = (y << 20) // scale  # y/x in Q40 (|y| < 2⁴² so y·2²⁰ fits)
+    ratio = (y << 20) // scale  # y/x in Q40 (|y| < 2⁴³ so y·2²⁰ fits)
     return x + ((y * (ratio >> 10)) >> 31), z + (ratio << 20)
 
 
@@ -270,10 +271,11 @@ def event_ticks(kernel: ExactKernel, x: float, y: float, theta: float) -> tuple[
     col_along, col_across = _rotate(step, 0, turn)
     row_along, row_across = _rotate(0, step, turn)
     reach = kernel.range_qp
-    # Cheap tests first, in Q24 (products stay under 2⁶²): K·r ≤ K·R < 1.6875·R, and (F < π/2) the centre
-    # within the cone, |across|·cos F ≤ along·sin F, with a slack far above the shifts' error; the exact
-    # test decides every cell they let through.
-    coarse = max(kernel.bits - 24, 0)
+    # Cheap tests first, in coarse units of 2^(33 − p) (every K-scaled coordinate of the window is under
+    # 2^61.3 by the choice of p, so coarse ones are under 2^28.3 and their products with Q30 constants under
+    # 2^59): K·r ≤ K·R < 1.6875·R, and (F < π/2) the centre within the cone, |across|·cos F ≤ along·sin F,
+    # with a slack far above the shifts' error; the exact test decides every cell they let through.
+    coarse = COARSE_SHIFT
     limit = (reach >> coarse) * 27 // 16 + 4
     narrow = kernel.half_angle_q60 < (PI_Q60 >> 1)
     under = 1 << max(kernel.bits - 45, 0)  # a centre this near (2⁻⁴⁵ units) is under the robot: r = θ_ix = 0

@@ -112,7 +112,7 @@ def _members(body: dict[str, Any], last_agent: int) -> list[int]:
 
 
 MAX_EVENT_COORDINATE = 2.0**20
-"""An event's x, y (and θ) beyond this are refused: the integer kernel holds positions up to 2²² units."""
+"""An event's x, y (and θ) beyond this are refused: the integer kernel holds positions up to 2²⁰ units."""
 MAX_TICKS = 2**40
 
 
@@ -322,7 +322,8 @@ def _decode_compact_step(payload: bytes, limits: Limits) -> AgentStep:
             (ticks,) = COMPACT_STAMP.unpack_from(payload, offset)
             offset += COMPACT_STAMP.size
             now = round(time.time() * STAMP_UNITS)
-            stamp = (now - (now - ticks) % 2**32) / STAMP_UNITS  # the latest time with these low bits
+            # The time with these low bits nearest the receiver's clock (a sender's clock may run ahead).
+            stamp = (now + (ticks - now + 2**31) % 2**32 - 2**31) / STAMP_UNITS
         if what & FIXED:
             (count,) = COMPACT_COUNT.unpack_from(payload, offset)
             offset += COMPACT_COUNT.size

@@ -11,7 +11,7 @@ decode may touch a map or a controller.
                 from and the cells whose ticks the integer kernel rounds otherwise): protocol.events
     AgentState  agent, step, pose at t_k, v, ω, e_Ω, pose at t_k+1 (step −1: hello), safety filter flags
     AgentStep   what an agent publishes each step: its MapDelta and its AgentState; with its delta as
-                an event it travels in the compact binary form below (82 bytes; 86 realtime)
+                an event it travels in the compact binary form below (82 bytes; 86 realtime; fixes 2 + 12 each)
     StepGo      lockstep: step k may start; every member's step k−1 delta and state
     Objectives  step k, members, targets (one per member), blob objectives  Alg. 1–2
     RunControl  kind (done | abort | status), step, completed, e_D, reason
@@ -226,7 +226,7 @@ The compact step (issue 13: at most 100 bytes on the bus per agent-step), little
 
     B 0xC1 · B PROTOCOL_VERSION · B what follows (1: a stamp, 2: fixes, 4: nothing sensed) ·
     H agent · I step · B safety flags · 9 float64: pose x, y, θ, v, ω, e_Ω, next pose x, y, θ ·
-    [I stamp: wall-clock time in 100 µs units modulo 2³², unwrapped by the receiver against its clock] ·
+    [I stamp: wall-clock time in 100 µs units modulo 2³², unwrapped by the receiver to the nearest time] ·
     [H count · count × (I index, Q ticks): the event's fixes]
 
 The delta is the sensing event from ``pose`` (protocol.events), or nothing sensed (a held step).

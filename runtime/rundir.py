@@ -7,6 +7,7 @@ run gives byte-identical files and a reader recovers the exact floats.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -155,9 +156,22 @@ def format_bandwidth(bandwidth: dict[str, Any], deltas: str) -> str:
 
 
 def write_counts(path: str | Path | None, counts: dict[str, object]) -> None:
-    """Persist a process's message counters (read by tests and by whoever studies a run); None: nowhere."""
+    """Persist a process's message counters (read by tests and by whoever studies a run); None: nowhere.
+    Written whole or not at all (a temporary file renamed), so a process killed meanwhile leaves no half file."""
     if path:
-        Path(path).write_text(json.dumps(counts, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+        target = Path(path)
+        partial = target.with_name(target.name + ".partial")
+        partial.write_text(json.dumps(counts, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+        os.replace(partial, target)
+
+
+def read_counts(path: Path) -> dict[str, Any] | None:
+    """A process's counters, or None when it wrote none (or what is there cannot be read)."""
+    try:
+        counts = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return counts if isinstance(counts, dict) else None
 
 
 def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, object] | None = None) -> dict[str, Any]:

@@ -96,3 +96,15 @@ def test_scenarios_the_integers_cannot_hold_are_refused():
     with pytest.raises(ValueError, match="2\\^20 units"):
         exact_kernel(10, 10, 1.0, 5e6, 0.5, 1.0, 0.1)
     assert exact_kernel_of(PAPER.with_overrides(range=3e6)) is None
+
+
+@pytest.mark.parametrize(("sensing_range", "cell"), [(150.0, 1.0), (1000.0, 8.0)])
+def test_long_ranges_keep_every_product_in_int64(sensing_range, cell):
+    """The window's coordinates scale with R: the kernel's fixed point shrinks so nothing wraps."""
+    side = 3.0 * sensing_range
+    scenario = PAPER.with_overrides(range=sensing_range, cell=cell, domain=(side, side))
+    sensed = differing = 0
+    for float_map, exact_map in float_and_exact(scenario, random_poses(150, seed=9, low=0.0, high=side)):
+        sensed += int(((float_map > 0) | (exact_map > 0)).sum())
+        differing += int((float_map != exact_map).sum())
+    assert sensed > 100_000 and differing <= sensed * 1e-5

@@ -59,7 +59,7 @@ def compact_round_trip(delta: MapDelta, state: AgentState, limits: Limits) -> tu
 
 
 def test_a_step_with_an_event_travels_compact_and_comes_back_whole():
-    """82 bytes in lockstep, 86 realtime (a 100 µs stamp), 12 more per fix; a held step's empty delta too."""
+    """82 bytes in lockstep, 86 realtime (a 100 µs stamp), 2 + 12 per fix; a held step's empty delta too."""
     import time
 
     from model.scenario import PAPER_SCENARIO, load_scenario
@@ -79,6 +79,8 @@ def test_a_step_with_an_event_travels_compact_and_comes_back_whole():
     plain = delta_of_event(3, 1234, SensingEvent(pose), limits.kernel)
     payload, back = compact_round_trip(plain, stamped, limits)
     assert len(payload) == 86 and abs(back.state.stamp - now) <= 1e-4
+    ahead = AgentState(3, 1234, pose, 0.5, -0.25, 0.125, (40.3, 61.45, -2.8), 0, now + 2.0)  # its clock runs ahead
+    assert abs(compact_round_trip(plain, ahead, limits)[1].state.stamp - (now + 2.0)) <= 1e-4
     held = MapDelta(3, 1234, 0, 0, np.zeros((0, 0), np.int64))
     payload, back = compact_round_trip(held, state, limits)
     assert len(payload) == 82 and back.delta.ticks.shape == (0, 0) and back.delta.event is None

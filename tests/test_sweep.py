@@ -11,6 +11,7 @@ import time
 
 import pytest
 
+import anicov.sweep
 from anicov.sweep import load_sweep, run_sweep
 from model.scenario import ScenarioError
 from tests.teamrun import ROOT, wait_for
@@ -59,6 +60,32 @@ def test_a_stopped_sweep_runs_only_what_it_lacks_and_drops_a_cut_line(tmp_path):
     (out / "runs.csv").write_text("".join(lines[:4]) + lines[4][:11])  # three rows whole, a fourth cut by a kill
     assert run_sweep(sweep, out, workers=1, progress=False) == (3, 5)
     assert len(rows_of(out)) == 8 and len({tuple(r.values()) for r in rows_of(out)}) == 8
+
+
+def flaky_run(sweep, point):
+    """run_point, but the zig-zag pair of two fails (module level: the pool's workers import it)."""
+    if point["agents"] == 2 and point["controller"] == "zigzag":
+        raise RuntimeError("a broken run")
+    return REAL_RUN_POINT(sweep, point)
+
+
+REAL_RUN_POINT = anicov.sweep.run_point
+
+
+def test_one_failing_run_loses_none_of_the_others(tmp_path, monkeypatch):
+    monkeypatch.setattr(anicov.sweep, "run_point", flaky_run)
+    with pytest.raises(ScenarioError, match=r"2 run\(s\) failed.*a broken run"):
+        run_sweep(load_sweep(write_sweep(tmp_path)), tmp_path / "out", workers=None, cluster=None, progress=False)
+    assert len(rows_of(tmp_path / "out")) == 6
+
+
+def test_grid_values_are_read_as_the_scenario_holds_them(tmp_path):
+    sweep = load_sweep(
+        write_sweep(tmp_path, text="seeds = 1\n[grid]\nrange = [8, 9.5]\n[fixed]\ndomain = [24.0, 24.0]\n")
+    )
+    assert sweep.grid["range"] == [8.0, 9.5]
+    with pytest.raises(ScenarioError, match="given twice"):
+        load_sweep(write_sweep(tmp_path, text="[grid]\nrange = [8, 8.0]\n"))
 
 
 def test_a_sweep_resumed_with_other_fixed_keys_is_refused(tmp_path):
