@@ -161,10 +161,18 @@ def declare_endpoints(session: zenoh.Session, node: AgentNode, lockstep: bool) -
     return Bus(session, node, step_publisher, token, history, LossTimer())
 
 
+SNAPSHOT_TRIES = 3
+"""Times a starting agent asks for the coordinator's snapshot (1 s each) before taking the run as fresh."""
+
+
 def resume_from_snapshot(session: zenoh.Session, node: AgentNode) -> bool:
     """A restarted robot: resume from the coordinator's snapshot, and the relays for the last steps
     that reached teammates but not the coordinator (see AgentNode.load_snapshot). False: a fresh run."""
-    snapshot = fetch_snapshot(session, node.keys.snapshot, node.limits, timeout=1.0)
+    snapshot = None
+    for _ in range(SNAPSHOT_TRIES):  # a session just opened may ask before it has heard of the queryable
+        snapshot = fetch_snapshot(session, node.keys.snapshot, node.limits, timeout=1.0)
+        if snapshot is not None:
+            break
     first = node.load_snapshot(snapshot) if snapshot is not None else None
     if snapshot is None or first is None:
         return False  # a fresh run: nothing of ours to resume
