@@ -80,9 +80,7 @@ def reproduce(
     zigzag = zigzag_reference(base)
     # One anicov sweep (anicov.sweep): its table OUT/runs.csv is kept, so a reproduction stopped half-way
     # resumes where it stopped. Team sizes in order, one agent (the longest runs) first.
-    sweep = Sweep(
-        base.with_overrides(controller="paper"), {"agents": sorted(teams)}, [seed + r for r in range(runs)], out_dir
-    )
+    sweep = Sweep(base.with_overrides(controller="paper"), {"agents": sorted(teams)}, [seed + r for r in range(runs)])
     run_sweep(sweep, out_dir, workers)
     outcomes: dict[int, list[tuple[int, bool, float, float]]] = {n: [] for n in teams}
     for row in read_done(out_dir / "runs.csv", sweep.columns):

@@ -62,7 +62,6 @@ class Sweep:
     base: Scenario
     grid: dict[str, list[Any]]
     seeds: list[int]
-    source: Path
 
     @property
     def columns(self) -> list[str]:
@@ -118,7 +117,7 @@ def load_sweep(path: Path) -> Sweep:
         seeds = list(range(seeds))
     elif not (isinstance(seeds, list) and seeds and all(isinstance(s, int) and not isinstance(s, bool) for s in seeds)):
         raise ScenarioError(f"{path}: seeds: expected a positive number of seeds or a list of integers")
-    return Sweep(base, grid, list(seeds), path)
+    return Sweep(base, grid, list(seeds))
 
 
 def run_point(sweep: Sweep, point: dict[str, Any]) -> dict[str, Any]:
