@@ -91,16 +91,19 @@ def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: 
     options = node.options
     lockstep = options.clock == "lockstep"
     bus = declare_endpoints(session, node, lockstep)
-    if resume_from_snapshot(session, node):
-        # Lockstep: it says hello like a new robot, and the coordinator lists it again from its next go.
-        node.rejoining = lockstep
-        log.info("agent %d resumes from the coordinator's snapshot after step %d", options.agent, node.step - 1)
     try:
-        wait_until_admitted(bus, stop, parent)
+        if not wait_for_agreement(bus, stop, parent):
+            bus.token.undeclare()
+            return exit_code(node, stop)
     except ScenarioMismatch as error:
         log.error("agent %d refuses to join: %s", options.agent, error)
         bus.token.undeclare()
         return EXIT_USAGE
+    if resume_from_snapshot(session, node):
+        # Lockstep: it says hello like a new robot, and the coordinator lists it again from its next go.
+        node.rejoining = lockstep
+        log.info("agent %d resumes from the coordinator's snapshot after step %d", options.agent, node.step - 1)
+    wait_until_admitted(bus, stop, parent)
     log.info("agent %d starts (%s clock)", options.agent, options.clock)
     try:
         if lockstep:
@@ -161,18 +164,23 @@ def declare_endpoints(session: zenoh.Session, node: AgentNode, lockstep: bool) -
     return Bus(session, node, step_publisher, token, history, LossTimer())
 
 
-SNAPSHOT_TRIES = 3
-"""Times a starting agent asks for the coordinator's snapshot (1 s each) before taking the run as fresh."""
+SNAPSHOT_TRIES = 10
+"""Times a starting agent asks the coordinator (known to be there) for its snapshot, 2 s each, before
+taking the run as fresh. A busy coordinator on a loaded machine can take over a second to answer."""
 
 
 def resume_from_snapshot(session: zenoh.Session, node: AgentNode) -> bool:
     """A restarted robot: resume from the coordinator's snapshot, and the relays for the last steps
-    that reached teammates but not the coordinator (see AgentNode.load_snapshot). False: a fresh run."""
+    that reached teammates but not the coordinator (see AgentNode.load_snapshot). False: a fresh run.
+    Called once the coordinator has answered the agreement, so an answer is due: it is asked again
+    until one comes (a session just opened may ask before it has heard of the queryable)."""
     snapshot = None
-    for _ in range(SNAPSHOT_TRIES):  # a session just opened may ask before it has heard of the queryable
-        snapshot = fetch_snapshot(session, node.keys.snapshot, node.limits, timeout=1.0)
+    for _ in range(SNAPSHOT_TRIES):
+        snapshot = fetch_snapshot(session, node.keys.snapshot, node.limits, timeout=2.0)
         if snapshot is not None:
             break
+    else:
+        log.warning("agent %d: the coordinator never answered for its snapshot; starting fresh", node.options.agent)
     first = node.load_snapshot(snapshot) if snapshot is not None else None
     if snapshot is None or first is None:
         return False  # a fresh run: nothing of ours to resume
@@ -181,22 +189,27 @@ def resume_from_snapshot(session: zenoh.Session, node: AgentNode) -> bool:
     return True
 
 
+def wait_for_agreement(bus: Bus, stop: StopFlag, parent: int) -> bool:
+    """Wait until the coordinator says it runs this agent's scenario and map (ScenarioMismatch if not).
+    False: stopped, or the launcher is gone, before it answered."""
+    node = bus.node
+    mine = digest_of(node.scenario)
+    while not stop.stopped:
+        theirs = coordinator_digest(bus.session, node.keys, node.limits, timeout=HELLO_PERIOD)
+        if theirs is not None:
+            check_agreement(mine, theirs, node.scenario)
+            return True
+        if parent_is_gone(parent):
+            return False
+    return False
+
+
 def wait_until_admitted(bus: Bus, stop: StopFlag, parent: int) -> None:
-    """Wait for the first go, saying hello until the coordinator has heard it. No hello before the
-    coordinator has said it runs this agent's scenario and map (ScenarioMismatch otherwise)."""
+    """Wait for the first go, saying hello until the coordinator has heard it."""
     node = bus.node
     next_hello = 0.0
     hellos = 0
-    mine, agreed = digest_of(node.scenario), False
     while not node.admitted() and node.finished is None and not stop.stopped:
-        if not agreed:
-            theirs = coordinator_digest(bus.session, node.keys, node.limits, timeout=HELLO_PERIOD)
-            if theirs is not None:
-                check_agreement(mine, theirs, node.scenario)
-                agreed = True
-            elif parent_is_gone(parent):
-                break
-            continue
         if time.monotonic() >= next_hello:
             bus.step_publisher.put(encode(node.hello()))
             next_hello = time.monotonic() + HELLO_PERIOD

@@ -19,6 +19,8 @@ import numpy as np
 from numba import njit
 from numba.typed import List
 
+from anicov.radio_engine import run_ranged
+from anicov.run_parts import finish_run, objective_fields
 from model.coverage_map import CoverageMap, add_window
 from model.ground import Ground, open_ground
 from model.parameters import coverage_map_of, law_parameters, safety_parameters, starting_poses
@@ -27,7 +29,7 @@ from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult
 from model.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move, sense_only
-from model.world import World, world_of
+from model.world import world_of
 from model.zigzag import boustrophedon_pilots, zigzag_pilots
 
 
@@ -104,6 +106,8 @@ def run_scenario(
     poses = starting_poses(scenario) if poses is None else np.array(poses, dtype=np.float64)
     if scenario.controller in ("zigzag", "boustrophedon"):
         return _run_zigzag(scenario, coverage_map, poses, record_trace, progress)
+    if math.isfinite(scenario.comm_range) or scenario.planning == "local":
+        return run_ranged(scenario, coverage_map, poses, record_trace, progress)
     law, world = law_parameters(scenario, coverage_map), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     planner = Planner(scenario)
@@ -144,57 +148,12 @@ def run_scenario(
             next_snapshot += SNAPSHOT_PERIOD
         if progress is not None:
             progress(now, coverage_map.domain_error())
-    result = _finish(scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace)
+    result = finish_run(
+        scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace
+    )
     result.plans = plans
     result.safety_flags = np.concatenate(flags) if flags else np.zeros((0, agents), dtype=np.uint8)
     return result
-
-
-def objective_fields(world: World, objectives: np.ndarray) -> np.ndarray:
-    """(N, rows, cols): the distance field of each agent's objective; a placeholder where no wall is."""
-    if not world.ground.walls:
-        return np.zeros((len(objectives), 1, 1))
-    return np.stack([world.field(*target) for target in objectives])
-
-
-def _finish(
-    scenario: Scenario,
-    coverage_map: CoverageMap,
-    poses: np.ndarray,
-    traces: list[np.ndarray],
-    errors: list[np.ndarray],
-    steps_done: int,
-    snapshot_times: list[float],
-    snapshots: list[np.ndarray],
-    record_trace: bool,
-    plan_time: float | None = None,
-    completion_step: int | None = None,
-) -> RunResult:
-    final_rows = np.zeros((1, scenario.agents, len(TRACE_FIELDS)))
-    final_rows[0, :, :3] = poses
-    if record_trace:
-        trace = np.concatenate([*traces, final_rows]) if traces else final_rows
-    else:
-        # Without a trace keep only |v| sums, laid out so path_lengths still works.
-        speed_sums = np.zeros((2, scenario.agents, len(TRACE_FIELDS)))
-        for chunk in traces:
-            speed_sums[0, :, 3] += chunk[0, :, 0]
-        speed_sums[1] = final_rows[0]
-        trace = speed_sums
-    completed = coverage_map.complete
-    completion_step = steps_done if completion_step is None else completion_step
-    return RunResult(
-        scenario=scenario,
-        completed=completed,
-        completion_time=completion_step * scenario.dt if completed else math.inf,
-        steps=steps_done,
-        trace=trace,
-        errors=np.concatenate(errors),
-        snapshot_times=snapshot_times,
-        snapshots=snapshots,
-        final_lack=coverage_map.lack_of_coverage(),
-        plan_time=plan_time,
-    )
 
 
 def _run_zigzag(
@@ -240,7 +199,7 @@ def _run_zigzag(
     snapshot_times.append(step * scenario.dt)
     snapshots.append(quantised_lack(coverage_map.lack_of_coverage()))
     chunks = [trace] if record_trace else [np.abs(trace[:, :, 3]).sum(axis=0)[None, :, None]]
-    return _finish(
+    return finish_run(
         scenario,
         coverage_map,
         poses,

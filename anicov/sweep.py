@@ -13,7 +13,8 @@ A sweep file::
 
 writes ``OUT/runs.csv``: one row per run, with every grid key, the seed and every figure of the run's
 summary (completed, completion_time, optimum_time, time_ratio, steps, team_path_length, final_error,
-and the safety figures when robots have a body). Each row is written and flushed as its run ends, so a
+the safety figures when robots have a body, the radio's with a limited
+comm_range or local planning). Each row is written and flushed as its run ends, so a
 sweep killed at any point loses at most the runs under way; started again on the same OUT it reads the
 table (a last line cut by the kill is dropped), runs only what is missing and says how many it found.
 Locally it uses every core; ``--cluster ADDRESS`` sends the runs to the workers of a running Dask
@@ -50,6 +51,9 @@ FIGURES = (
     "min_clearance",
     "filter_active_fraction",
     "deadlocks",
+    "divergence_mean",
+    "divergence_max",
+    "teammates_heard_mean",
 )
 """The summary's figures a row carries (those a run does not have are left empty)."""
 SWEEP_KEYS = ("scenario", "seeds", "grid", "fixed")
@@ -128,7 +132,8 @@ def run_point(sweep: Sweep, point: dict[str, Any]) -> dict[str, Any]:
     scenario = sweep.scenario_of(point)
     # The safety figures read the whole trace (robots with a body); the rest need only the path lengths.
     summary = summary_of(run_scenario(scenario, record_trace=scenario.robot_radius > 0.0))
-    return point | {figure: summary.get(figure) for figure in FIGURES}
+    figures = summary | summary.get("radio", {})
+    return point | {figure: figures.get(figure) for figure in FIGURES}
 
 
 def _key(point: dict[str, Any], names: list[str]) -> tuple[str, ...]:

@@ -16,7 +16,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from anicov.engine import advance_team, objective_fields, run_scenario
+from anicov.engine import advance_team, run_scenario
+from anicov.run_parts import objective_fields
 from bench.machine import describe_machine
 from model.coverage_map import CoverageMap
 from model.parameters import coverage_map_of, initial_poses, law_parameters, safety_parameters, starting_poses

@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from model.scenario_radio import RADIO_DEFAULTS, RadioKeyError, check_radio, resolve_radio_key
 from model.scenario_safety import SAFETY_DEFAULTS, SafetyKeyError, check_safety, resolve_safety_key
 from model.scenario_terrain import resolve_terrain_keys
 from model.terrain import TerrainError
@@ -66,6 +67,9 @@ class Scenario:
     max_pose_age: float = 0.5
     initial_poses: tuple[tuple[float, float, float], ...] = ()  # (x, y, θ in degrees) per robot
     objectives: tuple[tuple[float, float], ...] = ()  # fixed, instead of Algorithms 1-2
+    # Radio (issue 13, model/scenario_radio.py): the defaults are the paper's perfect network.
+    comm_range: float = math.inf
+    planning: str = "central"
     # Units (issue 15): what a length and a time unit are on a real robot (ROS: metres, seconds).
     metres_per_unit: float = 1.0
     seconds_per_unit: float = 1.0
@@ -97,7 +101,7 @@ class Scenario:
         for key in TERRAIN_KEYS:
             if getattr(self, key) == getattr(_OPEN_WORLD, key) or (key == "occlusion" and not self.has_terrain):
                 del values[key]
-        for key in UNIT_KEYS:
+        for key in (*UNIT_KEYS, *RADIO_DEFAULTS):
             if getattr(self, key) == getattr(_OPEN_WORLD, key):
                 del values[key]
         for key in SAFETY_DEFAULTS:
@@ -173,6 +177,11 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
                 resolved[key] = resolve_safety_key(key, value)
             except SafetyKeyError as error:
                 raise ScenarioError(str(error)) from error
+        elif key in RADIO_DEFAULTS:
+            try:
+                resolved[key] = resolve_radio_key(key, value)
+            except RadioKeyError as error:
+                raise ScenarioError(str(error)) from error
         elif key == "domain":
             if not isinstance(value, list | tuple) or len(value) != 2:
                 raise ScenarioError(f"scenario key 'domain': expected [width, height], got {value!r}")
@@ -221,7 +230,8 @@ def _check_whole(scenario: Scenario) -> Scenario:
         )
     try:
         check_safety(scenario)
-    except SafetyKeyError as error:
+        check_radio(scenario)
+    except (SafetyKeyError, RadioKeyError) as error:
         raise ScenarioError(str(error)) from error
     rows, cols = scenario.grid_shape
     for axis, cells, size in (("width", cols, scenario.domain[0]), ("height", rows, scenario.domain[1])):

@@ -61,6 +61,8 @@ def summary_of(result: RunResult) -> dict[str, Any]:
         summary["plan_time"] = result.plan_time
     if not world.open or scenario.priority_map:
         summary["terrain"] = world.summary()
+    if result.radio is not None:
+        summary["radio"] = result.radio
     if scenario.robot_radius > 0.0 and len(result.trace) == result.steps + 1:  # filter on or off, to compare
         summary |= safety_figures(
             result.trace[:, :, :2], result.safety_flags, world.ground, scenario.cell, result.timed_positions

@@ -1,0 +1,77 @@
+"""anicov.radio_engine: one replica per robot, a radio of limited range, central or local planning."""
+
+import math
+
+import numpy as np
+import pytest
+
+from anicov.engine import run_scenario
+from anicov.radio_engine import run_ranged
+from model.parameters import coverage_map_of, starting_poses
+from model.scenario import ScenarioError
+from runtime.rundir import summary_of
+
+
+@pytest.fixture
+def small(paper_scenario):
+    """A 40 × 40 square: runs of a second or two; a range of 8 still leaves robots out of touch."""
+    return paper_scenario.with_overrides(domain=[40.0, 40.0], agents=4, seed=2)
+
+
+@pytest.mark.parametrize("planning", ["central", "local"])
+def test_unlimited_range_equals_the_engine_byte_for_byte(small, planning):
+    """Every replica holds every event of step k at step k + 1, and every local planner computes the
+    central plan: the run is the paper's, central or local (run_scenario takes the paper's engine for
+    central planning with unlimited range: the ranged engine is called here directly)."""
+    reference = run_scenario(small)
+    scenario = small.with_overrides(planning=planning)
+    ranged = run_ranged(scenario, coverage_map_of(scenario), starting_poses(scenario), True, None)
+    assert ranged.radio is not None and ranged.radio["divergence_max"] == 0
+    assert ranged.trace.tobytes() == reference.trace.tobytes()
+    assert ranged.errors.tobytes() == reference.errors.tobytes()
+    assert [plan[2].tobytes() for plan in ranged.plans] == [plan[2].tobytes() for plan in reference.plans]
+
+
+@pytest.mark.parametrize("planning", ["central", "local"])
+def test_a_limited_range_diverges_replicas_and_still_covers(small, planning):
+    scenario = small.with_overrides(comm_range=8.0, planning=planning)
+    result = run_scenario(scenario)
+    assert result.completed
+    radio = result.radio
+    assert radio is not None
+    assert radio["divergence_max"] > 0 and radio["divergence_mean"] > 0  # replicas did differ
+    assert 0.0 <= radio["teammates_heard_mean"] < 3.0  # not everyone heard everyone
+    assert run_scenario(scenario).trace.tobytes() == result.trace.tobytes()  # deterministic
+    summary = summary_of(result)
+    assert summary["scenario"]["comm_range"] == 8.0 and summary["radio"] == radio
+
+
+def test_local_planning_with_a_limited_range_plans_differently_from_central(small):
+    central = run_scenario(small.with_overrides(comm_range=8.0))
+    local = run_scenario(small.with_overrides(comm_range=8.0, planning="local"))
+    assert central.trace.tobytes() != local.trace.tobytes()
+
+
+def test_the_paper_summary_has_no_radio_keys(small):
+    summary = summary_of(run_scenario(small))
+    assert "radio" not in summary and "comm_range" not in summary["scenario"] and "planning" not in summary["scenario"]
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        ({"comm_range": 0.0}, "scenario key 'comm_range': expected a positive number or inf"),
+        ({"comm_range": "far"}, "scenario key 'comm_range'"),
+        ({"planning": "everywhere"}, "scenario key 'planning': expected one of central, local"),
+        ({"planning": "local", "controller": "zigzag"}, "controller 'zigzag' flies fixed lanes"),
+        ({"robot_radius": 0.5, "comm_range": 2.0}, "scenario key 'comm_range': expected at least safety_range"),
+    ],
+)
+def test_bad_radio_keys_name_the_key(small, overrides, message):
+    with pytest.raises(ScenarioError, match=message.replace("(", r"\(")):
+        small.with_overrides(**overrides)
+
+
+def test_comm_range_inf_is_the_default(small):
+    assert small.comm_range == math.inf and small.with_overrides(comm_range=math.inf) == small
+    assert np.isinf(small.with_overrides(comm_range=float("inf")).comm_range)
