@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from agents.radio import RadioLink
 from agents.robot import Robot, SimulatedUnicycle
 from model.coverage_map import load_kernels as load_map_kernels
 from model.exact_coverage import load_kernels as load_event_kernel
@@ -74,7 +75,9 @@ class AgentNode:
         self.rejoining = False  # lockstep: restarted, waiting for a go that lists this agent again
         self.finished: RunControl | None = None
         self.bytes_sent = 0
-        self.relay = Relay(self.keys.agent_relay(options.agent))  # realtime: teammates' steps, for when one dies
+        # Realtime: teammates' steps, for when one dies; with a limited radio the whole run's, for anti-entropy.
+        self.radio = RadioLink(scenario, options.agent)  # comm_range and local planning
+        self.relay = Relay(self.keys.agent_relay(options.agent), capacity=self.radio.kept_steps())
         self.teammates: set[int] = set()  # alive, by their liveliness tokens
         self.teammates_left: list[int] = []
 
@@ -86,6 +89,12 @@ class AgentNode:
             return
         message = item.message
         if isinstance(message, AgentStep):  # realtime: teammates' deltas, applied as they come
+            if (
+                message.agent != self.options.agent
+                and item.live
+                and not self.radio.hears(message.state, self.robot.pose())
+            ):
+                return  # the radio would not have carried it
             if message.agent != self.options.agent:
                 self.replica.apply(message.delta)
                 self.relay.add(message.agent, message.delta.seq, item.payload)
@@ -93,7 +102,8 @@ class AgentNode:
         elif isinstance(message, AgentState) and message.step < 0 and message.agent != self.options.agent:
             # Realtime, a teammate's hello: where its robot really is (a real base need not stand at the
             # seeded start), for the line of sight and the safety filter before its first step arrives.
-            self.note_position(message)
+            if not item.live or self.radio.hears(message, self.robot.pose()):
+                self.note_position(message)
         elif isinstance(message, StepGo):
             if message.step >= self.step:
                 self.gos[message.step] = message
@@ -101,7 +111,8 @@ class AgentNode:
         elif isinstance(message, Objectives):
             if not self.started:
                 self.heard_at[:] = time.monotonic()  # realtime: the team starts moving now
-            self.take_targets(message)
+            if self.radio.planner is None:
+                self.take_targets(message)
             self.started = True
         elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
             self.finished = message
@@ -150,6 +161,21 @@ class AgentNode:
             if not state.safety & POSE_STALE:
                 self.heard_at[state.agent] = time.monotonic()
 
+    # ------------------------------------------------------------ radio (issue 13, agents/radio.py)
+
+    def plan_locally(self, members: list[int], pose: Pose) -> None:
+        """planning = "local": our own objective from our replica (see RadioLink.local_objective)."""
+        lack = self.replica.map.lack_of_coverage()
+        self.objective = self.radio.local_objective(members, pose, self.positions, lack, self.step)
+
+    def ends_on_its_own(self) -> bool:
+        """Realtime, local planning: end the run here when RadioLink.ends_now says so."""
+        if self.finished is None and self.radio.ends_now(self.replica.map.complete):
+            log.info("agent %d: its replica is complete and no coordinator ended the run: it ends", self.options.agent)
+            self.finished = RunControl("done", self.step, True, self.replica.map.domain_error(), reason="local")
+            return True
+        return False
+
     def take_targets(self, objectives: Objectives) -> None:
         target = objectives.target_of(self.options.agent)
         if target is not None:
@@ -170,7 +196,10 @@ class AgentNode:
         for state in go.states:
             self.note_position(state)
         if go.objectives is not None:
-            self.take_targets(go.objectives)
+            if self.radio.planner is None:
+                self.take_targets(go.objectives)
+            else:  # when the coordinator would plan, with the go's members (their poses are t_k's)
+                self.plan_locally(list(go.members), self.robot.pose())
         if self.replica.map.complete or self.step >= self.scenario.max_steps:
             return False  # the last go only completes the map: wait for the end of the run
         if self.objective is None:
@@ -219,11 +248,13 @@ class AgentNode:
         ``late`` (realtime, with the safety filter): the loop fell a period or more behind its clock, so
         this step is taken standing still. A robot catching up at full speed would move faster than
         k_v in wall time, beyond what its teammates' margins allow for (a real base's watchdog stops it)."""
-        assert self.objective is not None
         pose = self.robot.current_pose()
         me = self.options.agent
         if pose is None:
             return self.hold_step(self.robot.pose())
+        if self.options.clock == "realtime" and self.radio.plan_due(self.step):
+            self.plan_locally(self.radio.in_contact(), pose)
+        assert self.objective is not None
         self.positions[me] = pose[:2]
         field = self.world.field(*self.objective) if self.ground.walls else NO_FIELD
         v, omega, e_omega, row0, col0, ticks = decide_and_sense(
@@ -333,5 +364,7 @@ class AgentNode:
                 "steps": self.step,
                 "bytes_sent": self.bytes_sent,
                 "teammates_left": self.teammates_left,
+                "out_of_range": self.radio.out_of_range,
+                "domain_error": self.replica.map.domain_error(),
             }
         )

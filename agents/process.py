@@ -20,6 +20,7 @@ Clocks:
 from __future__ import annotations
 
 import logging
+import math
 import os
 import time
 from collections.abc import Iterator
@@ -35,6 +36,7 @@ from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_di
 from protocol.messages import AgentState, AgentStep, MapDelta, encode
 from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
 from protocol.session import RouterUnreachable, open_session, team_publisher, zenoh_config
+from protocol.sync import SYNC_PERIOD, SyncServer, sync_with
 from runtime.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
 from runtime.rundir import write_counts
 
@@ -155,8 +157,11 @@ def declare_endpoints(session: zenoh.Session, node: AgentNode, lockstep: bool) -
     token = session.liveliness().declare_token(keys.alive("agent", agent))
     settle_garbage_collector()
 
-    history = History(keys.agent_history(agent))
+    history = History(keys.agent_history(agent), capacity=node.radio.kept_steps())
     session.declare_queryable(keys.agent_history(agent), history.serve)
+    if not lockstep and math.isfinite(node.scenario.comm_range):
+        sync = SyncServer(keys.agent_sync(agent), agent, node.scenario.agents, history, node.relay)
+        session.declare_queryable(keys.agent_sync(agent), sync.serve)
     session.declare_queryable(
         keys.agent_snapshot(agent),
         lambda query: query.reply(keys.agent_snapshot(agent), encode(node.replica.snapshot())),
@@ -260,19 +265,36 @@ def run_realtime_steps(bus: Bus, period: float, stop: StopFlag, parent: int) -> 
     started = time.monotonic()
     next_gap_check = started + GAP_CHECK_PERIOD
     first_step = node.step
+    ranged = math.isfinite(node.scenario.comm_range)
+    last_sync: dict[int, float] = {}
     while node.finished is None and not stop.stopped and not parent_is_gone(parent):
         node.handle_queued()
         if node.finished is not None:
             break
         if time.monotonic() >= next_gap_check:
-            fill_gaps(bus.session, node.keys, node.replica, node.inbox)  # teammates' deltas lost on the way
+            if ranged:  # a limited radio: anti-entropy with the teammates in contact (protocol.sync)
+                exchange_with_contacts(bus, last_sync)
+            else:
+                fill_gaps(bus.session, node.keys, node.replica, node.inbox)  # teammates' deltas lost on the way
             fetch(bus.session, node.keys.go_history, node.inbox, first=END_ONLY)  # the end of the run, if lost
             next_gap_check = time.monotonic() + GAP_CHECK_PERIOD
         behind = time.monotonic() - (started + (node.step - first_step) * period)
+        if node.ends_on_its_own():
+            break
         bus.publish(*node.control_step(late=behind >= period))
         wait = started + (node.step - first_step) * period - time.monotonic()
         if wait > 0:
             stop.wait(wait)
+
+
+def exchange_with_contacts(bus: Bus, last_sync: dict[int, float]) -> None:
+    """Anti-entropy (protocol.sync) with each teammate in contact, at most once every SYNC_PERIOD."""
+    node = bus.node
+    now = time.monotonic()
+    for teammate in node.radio.in_contact():
+        if now - last_sync.get(teammate, -math.inf) >= SYNC_PERIOD:
+            last_sync[teammate] = now
+            sync_with(bus.session, node.keys.agent_sync(teammate), node.replica, node.inbox, node.scenario.agents)
 
 
 def finish_run(bus: Bus, lockstep: bool) -> None:

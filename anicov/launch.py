@@ -82,6 +82,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--out", help="run directory (default runs/<date-time>)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--no-record", action="store_true", help="no logger, no OUT/recording.rrd")
+    parser.add_argument(
+        "--coordinator-restarts",
+        type=int,
+        default=COORDINATOR_RESTARTS,
+        help=f"times a killed coordinator is started again (default {COORDINATOR_RESTARTS}); with planning = "
+        '"local" in the scenario the robots go on without it',
+    )
     parser.add_argument("--drop-rate", type=float, default=0.0, help=argparse.SUPPRESS)  # test hook: loss
     parser.add_argument("--viewer", action="store_true", help="spawn a live rerun viewer")
     parser.add_argument("--serve", action="store_true", help="serve a web viewer (for a browser on another machine)")
@@ -185,6 +192,7 @@ class Supervision:
     exit_code: int = EXIT_FAILED
     lost: list[str] = field(default_factory=list)
     restarts: int = 0
+    coordinator_lost: bool = False  # killed for good; local planning: the robots ended the run themselves
 
 
 class ControlWatch:
@@ -245,7 +253,9 @@ def main(argv: list[str] | None = None) -> int:
         router.declare_subscriber(keys.status, watch.on_sample)
         coordinator_command = start_team(args, scenario.agents, out_dir, children)
         try:
-            seen = supervise(children, coordinator_command, logs, watch, scenario, args.quiet, stop)
+            seen = supervise(
+                children, coordinator_command, logs, watch, scenario, args.quiet, stop, args.coordinator_restarts
+            )
         finally:
             if not stop.stopped:
                 # After the end of the run every child leaves by itself (the logger flushes first).
@@ -316,8 +326,10 @@ def supervise(
     scenario: Scenario,
     quiet: bool,
     stop: StopFlag,
+    restarts: int = COORDINATOR_RESTARTS,
 ) -> Supervision:
-    """Show progress until the coordinator exits; restart a killed coordinator; report lost robots."""
+    """Show progress until the coordinator exits; restart a killed coordinator (``restarts`` times); report
+    lost robots. With local planning a coordinator killed for good leaves the run to the robots."""
     from tqdm import tqdm
 
     seen = Supervision()
@@ -329,12 +341,17 @@ def supervise(
                 bar.set_postfix_str(f"t={status.step * scenario.dt:.0f}", refresh=False)
                 bar.update(max(0, round(100 * (1 - status.domain_error)) - bar.n))
             code = children[0].process.poll()
-            if code is not None and code < 0 and seen.restarts < COORDINATOR_RESTARTS:
+            if code is not None and code < 0 and seen.restarts < restarts:
                 # Killed, not finished: a new coordinator rebuilds the run from the agents' histories.
                 seen.restarts += 1
                 log.warning("the coordinator was killed (signal %d); starting it again (%d)", -code, seen.restarts)
                 children[0] = spawn(f"coordinator.restart-{seen.restarts}", coordinator_command, logs)
                 continue
+            if code is not None and code < 0 and scenario.planning == "local":
+                log.warning("the coordinator was killed (signal %d); with local planning the robots go on", -code)
+                seen.coordinator_lost = True
+                seen.exit_code = wait_for_agents([child for child in children if child.role.startswith("agent-")], stop)
+                break
             if code is not None:
                 seen.exit_code = code
                 break
@@ -351,12 +368,44 @@ def supervise(
     return seen
 
 
+def report_without_coordinator(
+    agents: int, out_dir: Path, children: list[Child], seen: Supervision, wall: float
+) -> int:
+    """Local planning after the coordinator was killed for good: what the robots did (no summary.json:
+    the coordinator writes it; the recording has the run)."""
+    from runtime.rundir import read_counts
+
+    logs = out_dir / "logs"
+    done = [child.role for child in children if child.role.startswith("agent-") and child.process.returncode == 0]
+    print(f"launch_team: the coordinator was killed and not restarted; local planning: {len(done)} of {agents} robots")
+    print("  ended the run on their own, each with a complete replica" if len(done) == agents else "  ended the run")
+    for agent in range(agents):
+        counts = read_counts(logs / f"agent-{agent}.counts.json") or {}
+        print(
+            f"  agent {agent}         e_D of its replica {counts.get('domain_error', '-')}, steps {counts.get('steps', '-')}"
+        )
+    if (out_dir / "recording.rrd").exists():
+        print(f"  recording       {out_dir / 'recording.rrd'}   (no summary.json: the coordinator writes it)")
+    print(f"  wall time       {wall:.1f} s")
+    return seen.exit_code
+
+
+def wait_for_agents(agents: list[Child], stop: StopFlag) -> int:
+    """Local planning without a coordinator: each robot ends the run when its replica is complete.
+    EXIT_OK if every one of them did, else EXIT_FAILED."""
+    while not stop.stopped and any(child.process.poll() is None for child in agents):
+        stop.wait(0.2)
+    return EXIT_OK if all(child.process.poll() == 0 for child in agents) else EXIT_FAILED
+
+
 def report(
     args: argparse.Namespace, agents: int, out_dir: Path, children: list[Child], seen: Supervision, wall: float
 ) -> int:
     """The one-screen summary of a finished run (or what failed), and the launcher's exit code."""
     logs = out_dir / "logs"
     summary_path = out_dir / "summary.json"
+    if seen.coordinator_lost:
+        return report_without_coordinator(agents, out_dir, children, seen, wall)
     if seen.exit_code in (EXIT_OK, EXIT_INCOMPLETE) and summary_path.exists():
         from runtime.rundir import bandwidth_of, format_bandwidth, format_summary, read_counts
 

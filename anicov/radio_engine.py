@@ -23,10 +23,10 @@ from model.parameters import law_parameters, safety_parameters
 from model.planning import Plan, Planner
 from model.radio import contacts, divergence, local_members, merge_knowledge
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack
-from model.safety import MEMORY_SIZE, filter_command
+from model.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
-from model.step import decide_and_sense, move
-from model.world import world_of
+from model.step import LawParameters, decide_and_sense, move
+from model.world import World, world_of
 
 Window = tuple[int, int, np.ndarray]
 
@@ -96,7 +96,6 @@ def run_ranged(
     team = RadioTeam(coverage_map, agents)
     central = Planner(scenario)
     planners = [Planner(scenario) for _ in range(agents)]
-    ages, kinds = np.zeros(agents), np.zeros(agents, dtype=np.int64)  # every robot sees t_k's poses
     rows: list[np.ndarray] = []
     flags: list[np.ndarray] = []
     errors = [coverage_map.domain_error()]
@@ -114,21 +113,7 @@ def run_ranged(
             fields = objective_fields(world, objectives)
             if record_trace:
                 plans.append(record_plan(scenario, central, step, objectives))
-        row = np.zeros((agents, len(TRACE_FIELDS)))
-        flag_row = np.zeros(agents, dtype=np.uint8)
-        windows: list[Window] = []
-        for i in range(agents):
-            x, y, theta = poses[i]
-            v, omega, e_omega, row0, col0, ticks = decide_and_sense(
-                team.replicas[i].coverage, x, y, theta, objectives[i, 0], objectives[i, 1], law, world.ground,
-                fields[i], positions, i,
-            )  # fmt: skip
-            if safety.enabled:
-                v, omega, flag_row[i] = filter_command(
-                    v, omega, i, poses, ages, kinds, world.ground, law.cell, safety, memory[i]
-                )
-            row[i] = (x, y, theta, v, omega, e_omega)
-            windows.append((row0, col0, ticks))
+        row, flag_row, windows = decide_team(team, poses, positions, objectives, fields, law, world, safety, memory)
         team.exchange(windows, in_contact)
         for i in range(agents):
             poses[i] = move(*poses[i], row[i, 3], row[i, 4], law, world.ground)
@@ -152,6 +137,39 @@ def run_ranged(
     result.safety_flags = np.stack(flags) if flags else np.zeros((0, agents), dtype=np.uint8)
     result.radio = team.figures()
     return result
+
+
+def decide_team(
+    team: RadioTeam,
+    poses: np.ndarray,
+    positions: np.ndarray,
+    objectives: np.ndarray,
+    fields: np.ndarray,
+    law: LawParameters,
+    world: World,
+    safety: SafetyParameters,
+    memory: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, list[Window]]:
+    """Every robot's step k from its own replica: the trace row (TRACE_FIELDS), the filter's flags and
+    the delta windows, as :func:`anicov.engine.advance_team` makes them from the one map."""
+    agents = len(poses)
+    ages, kinds = np.zeros(agents), np.zeros(agents, dtype=np.int64)  # every robot sees t_k's poses
+    row = np.zeros((agents, len(TRACE_FIELDS)))
+    flag_row = np.zeros(agents, dtype=np.uint8)
+    windows: list[Window] = []
+    for i in range(agents):
+        x, y, theta = poses[i]
+        v, omega, e_omega, row0, col0, ticks = decide_and_sense(
+            team.replicas[i].coverage, x, y, theta, objectives[i, 0], objectives[i, 1], law, world.ground,
+            fields[i], positions, i,
+        )  # fmt: skip
+        if safety.enabled:
+            v, omega, flag_row[i] = filter_command(
+                v, omega, i, poses, ages, kinds, world.ground, law.cell, safety, memory[i]
+            )
+        row[i] = (x, y, theta, v, omega, e_omega)
+        windows.append((row0, col0, ticks))
+    return row, flag_row, windows
 
 
 def plan_objectives(

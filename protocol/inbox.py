@@ -14,7 +14,7 @@ import threading
 import time
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import zenoh
 
@@ -25,11 +25,16 @@ from protocol.messages import AgentStep, Limits, Message, ProtocolError
 log = logging.getLogger("anicov.bus")
 
 
+ANY_AGENT = -1
+"""``relayed`` for an anti-entropy reply (protocol.sync): steps of any agent, from a teammate in range."""
+
+
 @dataclass(frozen=True)
 class Received:
     key: str
     message: Message
     payload: bytes = b""  # as it came: a relay keeps teammates' steps to serve them again
+    live: bool = True  # published to us; False: the answer to a query (history, relay, anti-entropy)
 
 
 @dataclass(frozen=True)
@@ -95,14 +100,14 @@ class Inbox:
             if relayed is not None:
                 with self._lock:
                     self.relayed += 1
-            self.queue.put(received)
+            self.queue.put(replace(received, live=False))
 
     def _validate(self, key: str, payload: bytes, relayed: int | None = None) -> Received | None:
         try:
             message = decode(payload, self.limits)
             agent = getattr(message, "agent", None)
             if relayed is not None:
-                if not isinstance(message, AgentStep) or agent != relayed:
+                if not isinstance(message, AgentStep) or (agent != relayed and relayed != ANY_AGENT):
                     raise ProtocolError("wrong-relay", f"{key} relayed {type(message).__name__} for agent {agent}")
             elif "/agent/" in key and agent is not None and agent != agent_of_key(key):
                 raise ProtocolError("wrong-sender", f"agent {agent} published on {key}")

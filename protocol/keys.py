@@ -7,6 +7,8 @@ agent/<id>/history          (queryable)          agent               its recent 
 agent/<id>/snapshot         (queryable)          agent               its replica: for a restarted coordinator
 agent/<id>/relay            (queryable)          agent               realtime: teammates' recent steps, served
                                                                      for one that died (?agent=<id>;steps=…)
+agent/<id>/sync             (queryable)          agent               comm_range: anti-entropy, ?have=<c0>,<c1>,…
+                                                                     → every step it holds beyond those counts
 coordinator/go              StepGo               coordinator → all   lockstep: step k may start, with every
                                                                      step k−1 delta and state, targets on replans
 coordinator/objectives      Objectives           coordinator → all   realtime: the latest targets
@@ -57,6 +59,9 @@ class TeamKeys:
 
     def agent_relay(self, agent: int) -> str:
         return f"{self.prefix}/agent/{agent}/relay"
+
+    def agent_sync(self, agent: int) -> str:
+        return f"{self.prefix}/agent/{agent}/sync"
 
     @property
     def coordinator_relay(self) -> str:

@@ -56,6 +56,12 @@ class History:
             steps = [step for step in self._items if first <= step <= last]
             return [payload for step in sorted(steps) for payload in self._items[step]] + list(self.final)
 
+    def after(self, step: int, limit: int) -> list[bytes]:
+        """At most ``limit`` payloads of the steps after ``step``, oldest first (no end of the run)."""
+        with self._lock:
+            steps = sorted(kept for kept in self._items if kept > step)[: max(limit, 0)]
+            return [payload for kept in steps for payload in self._items[kept]][: max(limit, 0)]
+
     def at(self, steps: list[int]) -> list[bytes]:
         with self._lock:
             return [payload for step in sorted(set(steps)) for payload in self._items.get(step, [])]
@@ -105,6 +111,10 @@ class Relay:
         if history is None:
             history = self._steps.setdefault(agent, History(self.key, self.capacity))
         history.add(seq, payload)
+
+    def of(self, agent: int) -> History | None:
+        """The kept steps of one teammate, if any."""
+        return self._steps.get(agent)
 
     def serve(self, query: zenoh.Query) -> None:
         """Reply with the kept steps of the agent named by ``?agent=``; anything malformed gets no reply."""

@@ -61,6 +61,13 @@ def scenario_from_arguments(args: argparse.Namespace) -> Scenario:
     speed = getattr(args, "speed", None)
     if speed is not None and speed <= 0:
         raise ScenarioError(f"--speed: expected a positive number, got {speed}")
+    if getattr(args, "clock", None) == "lockstep" and scenario.comm_range != float("inf"):
+        # Lockstep delivers every step through the coordinator's go: no radio to limit. (In process,
+        # `anicov run` models the range; over the bus the receivers filter realtime steps.)
+        raise ScenarioError(
+            f"scenario key 'comm_range' ({scenario.comm_range}): a limited radio needs --clock realtime on the bus "
+            "(lockstep steps travel in the coordinator's go); leave comm_range out, or run it with anicov run"
+        )
     check_world(scenario)
     return scenario
 

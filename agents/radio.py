@@ -1,0 +1,79 @@
+"""One robot's side of a limited radio (issue 13, :mod:`model.radio` for the rule): whom it hears, who is
+in contact, and local planning. The agent node owns one :class:`RadioLink`; no Zenoh here."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from model.planning import Planner
+from model.scenario import Scenario
+from protocol.messages import AgentState, Pose
+from protocol.recovery import RELAY_STEPS
+
+CONTACT_SECONDS = 1.0
+"""comm_range, realtime: a teammate heard live within this many wall seconds is in contact."""
+LOCAL_END_WAIT = 2.0
+"""Local planning, realtime: wall seconds a complete replica waits for the coordinator's end of the run."""
+
+
+class RadioLink:
+    """What the radio lets a robot know of its teammates, and its own planner when planning is local."""
+
+    def __init__(self, scenario: Scenario, me: int) -> None:
+        self.scenario = scenario
+        self.me = me
+        self.heard_live = np.full(scenario.agents, -np.inf)  # when each teammate was last heard (monotonic)
+        self.out_of_range = 0  # teammates' steps the radio did not deliver
+        self.planner = Planner(scenario) if scenario.planning == "local" else None
+        self.planned_at = -(10**9)  # local planning: the step of the last plan
+        self.complete_since: float | None = None  # local planning, realtime: when our replica became complete
+
+    def kept_steps(self) -> int:
+        """How many steps a history or relay keeps: the whole run where anti-entropy may ask for any."""
+        return max(20_000, self.scenario.max_steps) if math.isfinite(self.scenario.comm_range) else RELAY_STEPS
+
+    def hears(self, state: AgentState, pose: Pose) -> bool:
+        """The receiver's radio filter: a teammate's step (or hello) arrives only from within ``comm_range``
+        (its pose at that step against ours, ``pose``, now). Heard, it counts as contact."""
+        if math.isfinite(self.scenario.comm_range):
+            if math.hypot(state.pose[0] - pose[0], state.pose[1] - pose[1]) > self.scenario.comm_range:
+                self.out_of_range += 1
+                return False
+        if 0 <= state.agent < len(self.heard_live):
+            self.heard_live[state.agent] = time.monotonic()
+        return True
+
+    def in_contact(self) -> list[int]:
+        """Teammates heard live within the last CONTACT_SECONDS, by id."""
+        recent = time.monotonic() - CONTACT_SECONDS
+        return [agent for agent in range(self.scenario.agents) if agent != self.me and self.heard_live[agent] >= recent]
+
+    def plan_due(self, step: int) -> bool:
+        """Realtime, local planning: a plan every replan_period (and at the first step)."""
+        return self.planner is not None and step - self.planned_at >= self.scenario.replan_steps
+
+    def local_objective(
+        self, members: list[int], pose: Pose, positions: np.ndarray, lack: np.ndarray, step: int
+    ) -> tuple[float, float]:
+        """planning = "local": Algorithms 1-2 on our own replica's Υ (``lack``) for ``members`` and us, at
+        their last known ``positions`` (ours: ``pose``); our own objective (model.radio, local planning)."""
+        assert self.planner is not None
+        members = sorted(set(members) | {self.me})
+        where = np.array([pose[:2] if agent == self.me else positions[agent] for agent in members])
+        targets = self.planner.plan(lack, where, members)
+        self.planned_at = step
+        mine = targets[members.index(self.me)]
+        return float(mine[0]), float(mine[1])
+
+    def ends_now(self, complete: bool) -> bool:
+        """Local planning: our replica is ``complete`` (so the world is) and has been for LOCAL_END_WAIT
+        seconds without the coordinator ending the run (it is gone)."""
+        if self.planner is None or not complete:
+            return False
+        now = time.monotonic()
+        if self.complete_since is None:
+            self.complete_since = now
+        return now - self.complete_since >= LOCAL_END_WAIT

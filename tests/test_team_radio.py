@@ -1,0 +1,91 @@
+"""A team on a radio over real Zenoh (issue 13): local planning, a limited comm_range with anti-entropy,
+and a team that finishes without its coordinator."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import time
+
+from tests.teamrun import (
+    anicov,
+    launched_team,
+    launcher_command,
+    processes_of,
+    run,
+    unique_team,
+    wait_for,
+    write_scenario,
+)
+from tests.test_faults import agents_started, pid_of
+
+
+def agent_counts(run_dir, agents):
+    return [json.loads((run_dir / "logs" / f"agent-{i}.counts.json").read_text()) for i in range(agents)]
+
+
+def test_lockstep_local_planning_equals_the_engine(tmp_path):
+    """Every agent runs Algorithms 1-2 on its own replica (identical in lockstep) when the coordinator would:
+    each takes the objective the central plan gives it, so the run is the engine's byte for byte."""
+    config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=4, seed=3, planning="local")
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+    assert engine.returncode == 0, engine.stderr
+    central = anicov("run", "--config", str(config), "--out", str(tmp_path / "central"), "--quiet", "--no-record")
+    assert central.returncode == 0
+    team = unique_team()
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record", team=team))
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert (tmp_path / "engine" / "trajectory.csv").read_bytes() == (tmp_path / "team" / "trajectory.csv").read_bytes()
+    engine_summary = json.loads((tmp_path / "engine" / "summary.json").read_text())
+    team_summary = json.loads((tmp_path / "team" / "summary.json").read_text())
+    assert engine_summary.pop("radio")["divergence_max"] == 0  # the in-process figures of the radio
+    assert engine_summary == team_summary
+    assert processes_of(team) == []
+
+
+def test_realtime_limited_range_with_local_planning_completes_and_ends_with_one_map(tmp_path):
+    """comm_range 8 on a 40 × 40 square: robots drop the steps of teammates out of range (counted), learn
+    them by anti-entropy when they meet, plan for themselves; at the end every replica is the same map."""
+    config = write_scenario(
+        tmp_path / "s.toml", domain=[40.0, 40.0], agents=4, seed=3, planning="local", comm_range=8.0
+    )
+    team = unique_team()
+    out = tmp_path / "team"
+    command = launcher_command(
+        "--config", str(config), "--out", str(out), "--clock", "realtime", "--speed", "25", team=team
+    )
+    launched = run(command, timeout=400)
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "coverage        complete" in launched.stdout
+    counts = agent_counts(out, 4)
+    assert sum(count["out_of_range"] for count in counts) > 0  # the radio did cut some steps
+    assert sum(count["relayed"] for count in counts) > 0  # and anti-entropy brought steps from teammates
+    coordinator = json.loads((out / "coordinator_counts.json").read_text())
+    assert {count["map_digest"] for count in counts} == {coordinator["map_digest"]}
+    assert processes_of(team) == []
+
+
+def test_local_planning_finishes_the_run_after_the_coordinator_is_killed(tmp_path):
+    """Realtime, local planning: the coordinator is SIGKILLed 3 s into the run and not restarted; the
+    robots plan for themselves, end when their replicas are complete, and the logger still records."""
+    config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=4, seed=3, planning="local")
+    team = unique_team()
+    out = tmp_path / "team"
+    with launched_team(
+        "--config", str(config), "--out", str(out), "--clock", "realtime", "--speed", "10",
+        "--coordinator-restarts", "0", team=team,
+    ) as process:  # fmt: skip
+        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
+        time.sleep(3.0)
+        os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
+        stdout, stderr = process.communicate(timeout=400)
+    assert process.returncode == 0, stderr + stdout
+    assert "ended the run on their own" in stdout
+    counts = agent_counts(out, 4)
+    assert all(count["domain_error"] == 0.0 for count in counts)
+    assert all(
+        "no coordinator ended the run: it ends" in (out / "logs" / f"agent-{i}.log").read_text() for i in range(4)
+    )
+    assert (out / "recording.rrd").stat().st_size > 0 and not (out / "summary.json").exists()
+    assert processes_of(team) == []
