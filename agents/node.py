@@ -77,7 +77,7 @@ class AgentNode:
         self.bytes_sent = 0
         # Realtime: teammates' steps, for when one dies; with a limited radio the whole run's, for anti-entropy.
         self.radio = RadioLink(scenario, options.agent)  # comm_range and local planning
-        self.relay = Relay(self.keys.agent_relay(options.agent), capacity=self.radio.kept_steps())
+        self.relay = Relay(self.keys.agent_relay(options.agent), capacity=self.radio.relay_steps())
         self.teammates: set[int] = set()  # alive, by their liveliness tokens
         self.teammates_left: list[int] = []
 

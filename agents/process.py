@@ -157,7 +157,7 @@ def declare_endpoints(session: zenoh.Session, node: AgentNode, lockstep: bool) -
     token = session.liveliness().declare_token(keys.alive("agent", agent))
     settle_garbage_collector()
 
-    history = History(keys.agent_history(agent), capacity=node.radio.kept_steps())
+    history = History(keys.agent_history(agent), capacity=node.radio.history_steps())
     session.declare_queryable(keys.agent_history(agent), history.serve)
     if not lockstep and math.isfinite(node.scenario.comm_range):
         sync = SyncServer(keys.agent_sync(agent), agent, node.scenario.agents, history, node.relay)

@@ -11,7 +11,7 @@ import numpy as np
 from model.planning import Planner
 from model.scenario import Scenario
 from protocol.messages import AgentState, Pose
-from protocol.recovery import RELAY_STEPS
+from protocol.recovery import HISTORY_STEPS, RELAY_STEPS
 
 CONTACT_SECONDS = 1.0
 """comm_range, realtime: a teammate heard live within this many wall seconds is in contact."""
@@ -31,9 +31,15 @@ class RadioLink:
         self.planned_at = -(10**9)  # local planning: the step of the last plan
         self.complete_since: float | None = None  # local planning, realtime: when our replica became complete
 
-    def kept_steps(self) -> int:
-        """How many steps a history or relay keeps: the whole run where anti-entropy may ask for any."""
-        return max(20_000, self.scenario.max_steps) if math.isfinite(self.scenario.comm_range) else RELAY_STEPS
+    def history_steps(self) -> int:
+        """How many of its own steps a robot keeps: the whole run (a restarted coordinator rebuilds from
+        step 0, and anti-entropy may ask for any)."""
+        return max(HISTORY_STEPS, self.scenario.max_steps)
+
+    def relay_steps(self) -> int:
+        """How many steps of each teammate a robot keeps to serve again: the last few with every teammate
+        in range; the whole run where anti-entropy may ask for any."""
+        return self.history_steps() if math.isfinite(self.scenario.comm_range) else RELAY_STEPS
 
     def hears(self, state: AgentState, pose: Pose) -> bool:
         """The receiver's radio filter: a teammate's step (or hello) arrives only from within ``comm_range``

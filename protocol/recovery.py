@@ -30,6 +30,10 @@ MAX_STEPS_ASKED = 2000
 """The most single steps one history query may name (a selector must stay a reasonable size)."""
 
 
+HISTORY_STEPS = 20_000
+"""Steps a process keeps of what it published: a whole paper run (a restarted coordinator rebuilds from step 0)."""
+
+
 class History:
     """The last ``capacity`` steps of what a process published, served to whoever lost some of it.
 
@@ -38,7 +42,7 @@ class History:
     that notices a missing step asks the sender's history queryable for it.
     """
 
-    def __init__(self, key: str, capacity: int = 20_000) -> None:
+    def __init__(self, key: str, capacity: int = HISTORY_STEPS) -> None:
         self.key = key  # replies name this key, never the query's (which may be a wildcard)
         self.capacity = capacity
         self._items: dict[int, list[bytes]] = {}
