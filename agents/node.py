@@ -74,7 +74,9 @@ class AgentNode:
         self.members_seen: set[int] = set()  # lockstep: the members of the last go applied
         self.rejoining = False  # lockstep: restarted, waiting for a go that lists this agent again
         self.finished: RunControl | None = None
-        self.bytes_sent = 0
+        self.bytes_sent = 0  # payloads published
+        self.bytes_served = 0  # replies to teammates' queries (history, relay, anti-entropy), set at the end
+        self.created = time.monotonic()
         # Realtime: teammates' steps, for when one dies; with a limited radio the whole run's, for anti-entropy.
         self.radio = RadioLink(scenario, options.agent)  # comm_range and local planning
         self.relay = Relay(self.keys.agent_relay(options.agent), capacity=self.radio.relay_steps())
@@ -363,6 +365,8 @@ class AgentNode:
             | {
                 "steps": self.step,
                 "bytes_sent": self.bytes_sent,
+                "bytes_served": self.bytes_served,
+                "wall_seconds": round(time.monotonic() - self.created, 3),
                 "teammates_left": self.teammates_left,
                 "out_of_range": self.radio.out_of_range,
                 "domain_error": self.replica.map.domain_error(),

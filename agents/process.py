@@ -37,6 +37,7 @@ from protocol.messages import AgentState, AgentStep, MapDelta, encode
 from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
 from protocol.session import RouterUnreachable, open_session, team_publisher, zenoh_config
 from protocol.sync import SYNC_PERIOD, SyncServer, sync_with
+from protocol.traffic import TrafficReporter
 from runtime.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
 from runtime.rundir import write_counts
 
@@ -93,6 +94,7 @@ def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: 
     options = node.options
     lockstep = options.clock == "lockstep"
     bus = declare_endpoints(session, node, lockstep)
+    traffic = TrafficReporter(session, node.keys.traffic("agent", options.agent), "agent", options.agent, bus.traffic)
     try:
         if not wait_for_agreement(bus, stop, parent):
             bus.token.undeclare()
@@ -101,6 +103,7 @@ def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: 
         log.error("agent %d refuses to join: %s", options.agent, error)
         bus.token.undeclare()
         return EXIT_USAGE
+    traffic.start()
     if resume_from_snapshot(session, node):
         # Lockstep: it says hello like a new robot, and the coordinator lists it again from its next go.
         node.rejoining = lockstep
@@ -115,6 +118,8 @@ def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: 
     finally:
         node.robot.stop()  # before the end-of-run exchanges: a real base must not roll on meanwhile
     finish_run(bus, lockstep)
+    traffic.stop()
+    node.bytes_served = bus.traffic()[0] - node.bytes_sent
     bus.token.undeclare()
     return exit_code(node, stop)
 
@@ -129,6 +134,13 @@ class Bus:
     token: zenoh.LivelinessToken
     history: History
     loss: LossTimer  # lockstep: how long a silence means a lost go
+    sync: SyncServer | None = None  # comm_range: anti-entropy answers
+
+    def traffic(self) -> tuple[int, int]:
+        """Payload bytes out (published, and replies to teammates' queries) and in, so far."""
+        node = self.node
+        served = self.history.bytes_served + node.relay.bytes_served + (self.sync.bytes_served if self.sync else 0)
+        return node.bytes_sent + served, node.inbox.bytes_received
 
     def publish(self, delta: MapDelta, state: AgentState) -> None:
         payload = encode(AgentStep(delta, state))  # one message a step: one send, one delivery each
@@ -159,6 +171,7 @@ def declare_endpoints(session: zenoh.Session, node: AgentNode, lockstep: bool) -
 
     history = History(keys.agent_history(agent), capacity=node.radio.history_steps())
     session.declare_queryable(keys.agent_history(agent), history.serve)
+    sync = None
     if not lockstep and math.isfinite(node.scenario.comm_range):
         sync = SyncServer(keys.agent_sync(agent), agent, node.scenario.agents, history, node.relay)
         session.declare_queryable(keys.agent_sync(agent), sync.serve)
@@ -166,7 +179,7 @@ def declare_endpoints(session: zenoh.Session, node: AgentNode, lockstep: bool) -
         keys.agent_snapshot(agent),
         lambda query: query.reply(keys.agent_snapshot(agent), encode(node.replica.snapshot())),
     )
-    return Bus(session, node, step_publisher, token, history, LossTimer())
+    return Bus(session, node, step_publisher, token, history, LossTimer(), sync)
 
 
 SNAPSHOT_TRIES = 10

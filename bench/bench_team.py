@@ -28,7 +28,7 @@ from bench.machine import describe_machine  # noqa: E402
 from bench.pingpong import free_port, ping  # noqa: E402
 
 
-def run_team(agents: int, config: str | None, record: bool = False) -> dict[str, float]:
+def run_team(agents: int, config: str | None, record: bool = False, deltas: str = "event") -> dict[str, float]:
     with tempfile.TemporaryDirectory() as out:
         command = [
             sys.executable,
@@ -40,6 +40,8 @@ def run_team(agents: int, config: str | None, record: bool = False) -> dict[str,
             f"tcp/127.0.0.1:{free_port()}",
             "--out",
             out,
+            "--deltas",
+            deltas,
         ]
         if not record:
             command.append("--no-record")
@@ -60,6 +62,8 @@ def run_team(agents: int, config: str | None, record: bool = False) -> dict[str,
         "wall_s": wall,
         "steps_per_s": steps / counts["wall_seconds"],
         "bus_bytes_per_step": counts["bytes_received"] / steps + counts["bytes_sent"] / steps,
+        "go_bytes": counts["bytes_sent"] / steps,  # the coordinator sends one go a step (and a few others)
+        "step_bytes": counts["bytes_received"] / steps / agents,  # each agent's step message
         "recording_bytes_per_1000_steps": recording_bytes / steps * 1000,
     }
 
@@ -72,8 +76,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--skip-30", action="store_true", help="only N = 4")
     parser.add_argument("--repeats", type=int, default=3, help="runs of each N = 4 variant (default 3)")
+    parser.add_argument(
+        "--step-vs-exchange", action="store_true", help="only: the step against its bare exchange, cells and events"
+    )
     args = parser.parse_args()
     print(f"machine: {describe_machine()}")
+    if args.step_vs_exchange:
+        step_against_exchange((4,) if args.skip_30 else (4, 30), args.repeats)
+        return
     rtt, peer = bare_round_trips()
     small_teams(rtt, peer)
     logger_cost(args.repeats, rtt, peer)
@@ -148,6 +158,25 @@ def table_row(name: str, runs: list[dict[str, float]], rtt: dict[str, float], pe
         f"{median(trips):.1f} / {median(peer_trips):.1f} | "
         f"{median([run['bus_bytes_per_step'] for run in runs]):,.0f} |"
     )
+
+
+def step_against_exchange(team_sizes: tuple[int, ...], repeats: int) -> None:
+    """Issue 13: a lockstep step over Zenoh against the bare exchange of the same messages with no work in
+    it (bench/fanout.py, with the go and step sizes the run measured), deltas as cells (before) and as
+    sensing events (after), each in the same bench run. Medians of ``repeats`` team runs."""
+    print("\n| N | deltas | go / step message (B) | step (µs) | bare exchange (µs) | step / exchange |")
+    print("|---|---|---|---|---|---|")
+    for agents in team_sizes:
+        for deltas in ("cells", "event"):
+            runs = [run_team(agents, None, deltas=deltas) for _ in range(repeats if agents < 10 else 1)]
+            step_us = median([run["stepping_s"] / run["steps"] * 1e6 for run in runs])
+            go, reply = round(median([r["go_bytes"] for r in runs])), round(median([r["step_bytes"] for r in runs]))
+            exchange = fan_out(agents, 2000 if agents < 10 else 500, go, reply, handoff=True)["median_us"]
+            print(
+                f"| {agents} | {deltas} | {go:,} / {reply:,} | {step_us:.0f} | {exchange:.0f} | "
+                f"{step_us / exchange:.2f} |",
+                flush=True,
+            )
 
 
 def team_of_30() -> None:

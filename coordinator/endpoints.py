@@ -48,6 +48,10 @@ class CoordinatorBus:
         token = session.liveliness().declare_token(keys.alive("coordinator"))
         return cls(session, keys, node, objectives, go, go_history, control, status, token)
 
+    def traffic(self) -> tuple[int, int]:
+        """Payload bytes out (published, and the gos served again) and in, so far."""
+        return self.node.bytes_sent + self.go_history.bytes_served, self.node.inbox.bytes_received
+
     def publish(self, publisher: zenoh.Publisher, message: Message | bytes) -> None:
         payload = message if isinstance(message, bytes) else encode(message)
         self.node.bytes_sent += len(payload)

@@ -25,6 +25,7 @@ from model.scenario import Scenario
 from protocol.messages import RunControl
 from protocol.recovery import LossTimer
 from protocol.session import open_session
+from protocol.traffic import TrafficReporter
 from runtime.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, StopFlag, parent_is_gone, settle_garbage_collector
 
 log = logging.getLogger("anicov.coordinator")
@@ -35,6 +36,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
     parent = os.getppid()
     with open_session(config) as session:
         bus = CoordinatorBus.declare(session, node)
+        traffic = TrafficReporter(session, bus.keys.traffic("coordinator"), "coordinator", 0, bus.traffic).start()
         loss = LossTimer()  # from here, as before: the first step's patience includes the start
         settle_garbage_collector()
         load_map_kernels()  # while the agents start, not in step 0
@@ -47,6 +49,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             missing = "" if found.logger_ready else " and no logger appeared"
             log.error("only %d of %d agents said hello%s; giving up", len(node.positions), scenario.agents, missing)
             bus.announce(RunControl("abort", 0, reason="agents missing at start"))
+            traffic.stop()
             bus.token.undeclare()
             return stop.exit_code(EXIT_FAILED)
         else:
@@ -65,6 +68,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                 stepping.status_if_due()
         done = announce_end(bus, stepping)
         settle_last_deltas(bus, done)
+        traffic.stop()
         bus.token.undeclare()
         write_outputs(bus, stepping, step if found.running else None, options.out)
     if stepping.outcome is None:

@@ -66,14 +66,14 @@ def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config,
             _load_snapshot(session, keys, node)  # anything lost on the way: the coordinator's map is the reference
         token.undeclare()
     node.finish()
-    write_counts(options.counts_file, node.inbox.counts())
+    write_counts(options.counts_file, node.inbox.counts() | {"bandwidth": node.bandwidth()})
     return stop.exit_code(EXIT_OK)
 
 
 def _subscribe(session: zenoh.Session, keys: TeamKeys, node: TeamLogger, lockstep: bool) -> None:
     """Subscribe to what the logger reads live (realtime: the steps and objectives too)."""
-    traffic = () if lockstep else (keys.all_steps, keys.objectives)
-    for key in (*traffic, keys.control):
+    live_steps = () if lockstep else (keys.all_steps, keys.objectives)
+    for key in (*live_steps, keys.control, keys.all_traffic):
         session.declare_subscriber(key, node.inbox.on_sample)
     session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
 

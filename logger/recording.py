@@ -21,8 +21,11 @@ units with y pointing up (x/cell, rows − y/cell):
     agents/<i>/safety_filter           Scalars        1 while the filter changes or stops the command, else 0
     metrics/e_D                        Scalars        eq. 5 (Fig. 4)
     agents/<i>/e_omega, v, omega       Scalars        eq. 6, 15, 16 (Fig. 5)
+    bus/<role>-<id>/bytes_in, bytes_out  Scalars      over the bus only: each process's bytes per wall
+                                                      second (its Traffic reports, one a second)
     run/scenario                       TextDocument   scenario, seed, team size (static)
     run/events                         TextLog        joined, left, done
+    run/bandwidth                      TextDocument   over the bus only: each process's bytes in total and a second
 
 Timelines: ``step`` (sequence) and ``sim_time`` (duration, one second per
 simulated time unit).
@@ -61,6 +64,7 @@ def default_blueprint(agents: int) -> rrb.Blueprint:
                 rrb.TimeSeriesView(origin="/agents", contents="/agents/*/v", name="v per agent (Fig. 5)"),
                 rrb.TimeSeriesView(origin="/agents", contents="/agents/*/omega", name="ω per agent (Fig. 5)"),
                 rrb.TimeSeriesView(origin="/agents", contents="/agents/*/e_omega", name="e_Ω per agent"),
+                rrb.TimeSeriesView(origin="/bus", name="bytes per second per process"),
             ),
             column_shares=[3, 2],
         ),
@@ -257,6 +261,25 @@ class RunRecorder:
                 rr.TimeColumn("sim_time", duration=steps * self.scenario.dt),
             ],
             columns=rr.Scalars.columns(scalars=errors),
+        )
+
+    def traffic(self, step: int, process: str, bytes_in_per_second: float, bytes_out_per_second: float) -> None:
+        """One process's bytes per wall second since its previous report (``process``: e.g. agent-2)."""
+        self._at(step)
+        self.stream.log(f"bus/{process}/bytes_in", rr.Scalars(bytes_in_per_second))
+        self.stream.log(f"bus/{process}/bytes_out", rr.Scalars(bytes_out_per_second))
+
+    def bandwidth_table(self, step: int, rows: list[tuple[str, float, int, int]]) -> None:
+        """Each process's totals: (process, wall seconds, bytes out, bytes in)."""
+        self._at(step)
+        lines = ["| process | seconds | bytes out | bytes in | out B/s | in B/s |", "|---|---|---|---|---|---|"]
+        for process, seconds, bytes_out, bytes_in in rows:
+            per = 1.0 / seconds if seconds > 0 else 0.0
+            lines.append(
+                f"| {process} | {seconds:.1f} | {bytes_out} | {bytes_in} | {bytes_out * per:.0f} | {bytes_in * per:.0f} |"
+            )
+        self.stream.log(
+            "run/bandwidth", rr.TextDocument("\n".join(["# Bandwidth", *lines]), media_type="text/markdown")
         )
 
     def lack_map(self, step: int, lack: np.ndarray) -> None:

@@ -14,6 +14,7 @@ import numpy as np
 from rerun.chunk import RrdReader
 
 _AGENT = re.compile(r"^/world/agents/(\d+)/")
+_BUS = re.compile(r"^/bus/([a-z]+-\d+)/(bytes_in|bytes_out)$")
 
 
 @dataclass
@@ -24,6 +25,7 @@ class RecordingContent:
     domain_error: dict[int, float] = field(default_factory=dict)  # step → e_D
     positions: dict[int, dict[int, tuple[float, float]]] = field(default_factory=dict)  # agent → step → view (x, y)
     maps: dict[int, np.ndarray] = field(default_factory=dict)  # step → Υ as logged (view orientation)
+    traffic: dict[tuple[str, str], list[float]] = field(default_factory=dict)  # (process, bytes_in|out) → B/s
 
     @property
     def agents(self) -> list[int]:
@@ -59,6 +61,9 @@ def summarise_recording(path: Path, load_maps: bool = True) -> RecordingContent:
             content.positions.setdefault(agent, {}).update(
                 {int(s): (float(p[0][0]), float(p[0][1])) for s, p in zip(steps, points, strict=True)}
             )
+        elif match := _BUS.match(entity):
+            values = batch.column("Scalars:scalars").to_pylist()
+            content.traffic.setdefault((match.group(1), match.group(2)), []).extend(float(v[0]) for v in values)
         elif entity == "/world/map/lack_of_coverage" and load_maps:
             buffers = batch.column("Image:buffer").to_pylist()
             formats = batch.column("Image:format").to_pylist()
@@ -78,8 +83,16 @@ def format_recording_summary(content: RecordingContent) -> str:
         + ")",
         "final e_D        " + ("-" if content.final_domain_error is None else f"{content.final_domain_error:.6f}"),
         f"maps logged      {len(content.maps)}",
-        f"entities         {len(content.entities)}",
     ]
+    for process in sorted({process for process, _ in content.traffic}):
+        mean = {
+            direction: float(np.mean(values)) if (values := content.traffic.get((process, direction))) else 0.0
+            for direction in ("bytes_out", "bytes_in")
+        }
+        lines.append(
+            f"bus {process:<12} out {mean['bytes_out']:.0f} B/s, in {mean['bytes_in']:.0f} B/s (mean of reports)"
+        )
+    lines.append(f"entities         {len(content.entities)}")
     shown = sorted(entity for entity in content.entities if not _AGENT.match(entity) or "/0/" in entity)
     lines += [f"  {entity}" for entity in shown]
     if len(content.agents) > 1:

@@ -7,6 +7,7 @@ or by a test.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -15,7 +16,7 @@ import numpy as np
 from logger.recording import RunRecorder
 from model.scenario import Scenario
 from protocol.inbox import Inbox, Membership, Received
-from protocol.messages import AgentState, AgentStep, Limits, Objectives, RunControl, Snapshot, StepGo
+from protocol.messages import AgentState, AgentStep, Limits, Objectives, RunControl, Snapshot, StepGo, Traffic
 from protocol.replica import MapReplica
 
 
@@ -54,6 +55,8 @@ class TeamLogger:
         self.logged_map_step = -1
         self.finished: RunControl | None = None
         self.next_go = 0  # lockstep: the first go not read yet
+        self.traffic: dict[str, Traffic] = {}  # each process's latest report
+        self.started = time.monotonic()  # the logger's own traffic: what its inbox took in since
 
     def handle(self, item: Received | Membership) -> None:
         if isinstance(item, Membership):
@@ -75,6 +78,40 @@ class TeamLogger:
             self.take_objectives(message)
         elif isinstance(message, RunControl) and message.kind in ("done", "abort"):
             self.finished = message
+        elif isinstance(message, Traffic):
+            self.take_traffic(message)
+
+    def take_traffic(self, report: Traffic) -> None:
+        """Bytes per second since the process's previous report (none before its first; a restarted
+        process, whose counters start again, is taken from its new first report)."""
+        process = f"{report.role}-{report.ident}"
+        previous = self.traffic.get(process)
+        self.traffic[process] = report
+        if previous is None or report.seconds <= previous.seconds or report.bytes_out < previous.bytes_out:
+            return
+        elapsed = report.seconds - previous.seconds
+        self.recorder.traffic(
+            max(self.latest_step, 0),
+            process,
+            (report.bytes_in - previous.bytes_in) / elapsed,
+            (report.bytes_out - previous.bytes_out) / elapsed,
+        )
+
+    def bandwidth(self) -> dict[str, dict[str, float]]:
+        """Each process's last report, and the logger's own counters: wall seconds, bytes out and in, and
+        their rates."""
+        table = {}
+        own = Traffic("logger", 0, time.monotonic() - self.started, 0, self.inbox.bytes_received)
+        for process, report in sorted((self.traffic | {"logger-0": own}).items()):
+            per = 1.0 / report.seconds if report.seconds > 0 else 0.0
+            table[process] = {
+                "seconds": round(report.seconds, 3),
+                "bytes_out": report.bytes_out,
+                "bytes_in": report.bytes_in,
+                "bytes_out_per_second": round(report.bytes_out * per, 1),
+                "bytes_in_per_second": round(report.bytes_in * per, 1),
+            }
+        return table
 
     def take_go(self, go: StepGo) -> None:
         """Lockstep: the whole previous step in one message."""
@@ -127,4 +164,7 @@ class TeamLogger:
         else:
             text = "logger stopped before the end of the run"
         self.recorder.event(final_step, text)
+        if self.traffic:
+            rows = [(name, row["seconds"], row["bytes_out"], row["bytes_in"]) for name, row in self.bandwidth().items()]
+            self.recorder.bandwidth_table(final_step, rows)
         self.recorder.close()

@@ -31,6 +31,7 @@ from protocol.messages import (
     RUN_CONTROL_KINDS,
     STAMP_UNITS,
     STAMPED,
+    TRAFFIC_ROLES,
     AgentState,
     AgentStep,
     Limits,
@@ -44,6 +45,7 @@ from protocol.messages import (
     SensingEvent,
     Snapshot,
     StepGo,
+    Traffic,
 )
 
 
@@ -294,6 +296,23 @@ def _decode_digest(body: dict[str, Any], limits: Limits) -> ScenarioDigest:
     return ScenarioDigest(scenario, map_sha)
 
 
+MAX_BYTES_COUNTED = 2**62
+"""Byte counters above this are refused (a process would need decades at any link's speed)."""
+
+
+def _decode_traffic(body: dict[str, Any], limits: Limits) -> Traffic:
+    role = body.get("role")
+    if role not in TRAFFIC_ROLES:
+        raise ProtocolError("bad-field", f"role must be one of {TRAFFIC_ROLES}")
+    ident = _int(body, "ident", 0, limits.agents - 1 if role == "agent" else 0)
+    seconds = _finite(body.get("seconds"), "seconds")
+    if seconds < 0.0:
+        raise ProtocolError("bad-field", "seconds must be >= 0")
+    return Traffic(
+        role, ident, seconds, _int(body, "out", 0, MAX_BYTES_COUNTED), _int(body, "in", 0, MAX_BYTES_COUNTED)
+    )
+
+
 _DECODERS: dict[str, Callable[[dict[str, Any], Limits], Message]] = {
     "delta": _decode_delta,
     "state": _decode_state,
@@ -303,6 +322,7 @@ _DECODERS: dict[str, Callable[[dict[str, Any], Limits], Message]] = {
     "control": _decode_control,
     "snapshot": _decode_snapshot,
     "scenario": _decode_digest,
+    "traffic": _decode_traffic,
 }
 """Each message type's decoder: it validates the body and builds the message, or raises ProtocolError."""
 

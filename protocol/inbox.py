@@ -20,7 +20,7 @@ import zenoh
 
 from protocol.decoding import decode
 from protocol.keys import agent_of_key
-from protocol.messages import AgentStep, Limits, Message, ProtocolError
+from protocol.messages import AgentStep, Limits, Message, ProtocolError, Traffic
 
 log = logging.getLogger("anicov.bus")
 
@@ -111,6 +111,8 @@ class Inbox:
                     raise ProtocolError("wrong-relay", f"{key} relayed {type(message).__name__} for agent {agent}")
             elif "/agent/" in key and agent is not None and agent != agent_of_key(key):
                 raise ProtocolError("wrong-sender", f"agent {agent} published on {key}")
+            elif isinstance(message, Traffic) and not key.endswith(f"/traffic/{message.role}/{message.ident}"):
+                raise ProtocolError("wrong-sender", f"{message.role} {message.ident}'s traffic published on {key}")
         except ProtocolError as error:
             self._reject(error.reason, key, str(error))
             return None

@@ -18,6 +18,7 @@ coordinator/scenario        (queryable)          coordinator         ScenarioDig
 coordinator/relay           (queryable)          coordinator         realtime: as agent/<id>/relay
 run/control                 RunControl           coordinator → all   run done / aborted
 run/status                  RunControl           coordinator → all   progress (e_D, step)
+traffic/<role>/<id>         Traffic              every process       bytes out and in so far, each second
 alive/<role>/<id>           liveliness token     every process       agent/<id>, coordinator/0, logger/0
 """
 
@@ -106,6 +107,13 @@ class TeamKeys:
     @property
     def status(self) -> str:
         return f"{self.prefix}/run/status"
+
+    def traffic(self, role: str, ident: int = 0) -> str:
+        return f"{self.prefix}/traffic/{role}/{ident}"
+
+    @property
+    def all_traffic(self) -> str:
+        return f"{self.prefix}/traffic/**"
 
     def alive(self, role: str, ident: int = 0) -> str:
         return f"{self.prefix}/alive/{role}/{ident}"

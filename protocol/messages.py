@@ -17,6 +17,7 @@ decode may touch a map or a controller.
     RunControl  kind (done | abort | status), step, completed, e_D, reason
     Snapshot    the coverage map and the applied sequences per agent
     ScenarioDigest  sha256 of the scenario as run and of its map (a process checks it joins its team's run)
+    Traffic     a process's bytes out and in since it started, every second (bandwidth you can see)
 """
 
 from __future__ import annotations
@@ -166,7 +167,22 @@ class ScenarioDigest:
     map_sha256: str
 
 
-Message = MapDelta | AgentState | AgentStep | Objectives | RunControl | Snapshot | StepGo | ScenarioDigest
+TRAFFIC_ROLES = ("agent", "coordinator", "logger")
+
+
+@dataclass(frozen=True)
+class Traffic:
+    """What one process has put on the bus and taken from it since it started (payload bytes, counters
+    that only grow), ``seconds`` after its start: a listener turns two reports into bytes per second."""
+
+    role: str
+    ident: int
+    seconds: float
+    bytes_out: int
+    bytes_in: int
+
+
+Message = MapDelta | AgentState | AgentStep | Objectives | RunControl | Snapshot | StepGo | ScenarioDigest | Traffic
 
 
 # ---------------------------------------------------------------- encoding
@@ -307,4 +323,15 @@ def encode(message: Message) -> bytes:
         )
     if isinstance(message, ScenarioDigest):
         return _pack("scenario", {"scenario": message.scenario, "map": message.map_sha256})
+    if isinstance(message, Traffic):
+        return _pack(
+            "traffic",
+            {
+                "role": message.role,
+                "ident": message.ident,
+                "seconds": message.seconds,
+                "out": message.bytes_out,
+                "in": message.bytes_in,
+            },
+        )
     raise TypeError(f"not a protocol message: {type(message).__name__}")

@@ -48,6 +48,7 @@ class History:
         self._items: dict[int, list[bytes]] = {}
         self._lock = threading.Lock()
         self.final: list[bytes] = []  # sent with every reply once set (the end of the run)
+        self.bytes_served = 0  # payload bytes of every reply (the process's traffic out)
 
     def add(self, step: int, *payloads: bytes) -> None:
         with self._lock:
@@ -84,6 +85,7 @@ class History:
                 payloads = self.between(first, last)
         except ValueError:
             return
+        self.bytes_served += sum(len(payload) for payload in payloads)
         for payload in payloads:
             query.reply(self.key, payload)
 
@@ -115,6 +117,11 @@ class Relay:
         if history is None:
             history = self._steps.setdefault(agent, History(self.key, self.capacity))
         history.add(seq, payload)
+
+    @property
+    def bytes_served(self) -> int:
+        """Payload bytes of every reply so far."""
+        return sum(history.bytes_served for history in list(self._steps.values()))
 
     def of(self, agent: int) -> History | None:
         """The kept steps of one teammate, if any."""

@@ -56,6 +56,7 @@ class SyncServer:
         self.history = history
         self.relay = relay
         self.served = 0  # steps sent to teammates
+        self.bytes_served = 0  # their payload bytes
 
     def lacking(self, have: list[int]) -> list[bytes]:
         """Every step we hold that a replica with these counts lacks, oldest first within each agent."""
@@ -74,6 +75,7 @@ class SyncServer:
             return  # malformed: no reply
         payloads = self.lacking(have)
         self.served += len(payloads)
+        self.bytes_served += sum(len(payload) for payload in payloads)
         for payload in payloads:
             query.reply(self.key, payload)
 

@@ -130,15 +130,16 @@ def _safety_line(summary: dict[str, Any]) -> str:
 
 
 def bandwidth_of(agent_counts: list[dict[str, Any]], dt: float) -> dict[str, Any] | None:
-    """Bytes each robot sent and took in over the run (its counters: every payload it published and every
-    one its inbox received), per step and per second at speed 1 (1/dt steps a second); None if no agent
-    stepped."""
+    """Bytes each robot sent and took in over the run (its counters: every payload it published or served
+    to a teammate's query, and every one its inbox received), per step, per second at speed 1 (1/dt steps
+    a second) and per wall second of this run; None if no agent stepped."""
     stepped = [counts for counts in agent_counts if counts.get("steps", 0) > 0]
     if not stepped:
         return None
-    out = [counts["bytes_sent"] / counts["steps"] for counts in stepped]
+    sent = [counts["bytes_sent"] + counts.get("bytes_served", 0) for counts in stepped]
+    out = [total / counts["steps"] for total, counts in zip(sent, stepped, strict=True)]
     into = [counts["bytes_received"] / counts["steps"] for counts in stepped]
-    return {
+    bandwidth = {
         "agents_counted": len(stepped),
         "bytes_out_per_step": sum(out) / len(out),
         "bytes_in_per_step": sum(into) / len(into),
@@ -146,6 +147,13 @@ def bandwidth_of(agent_counts: list[dict[str, Any]], dt: float) -> dict[str, Any
         "bytes_in_per_second_at_speed_1": sum(into) / len(into) / dt,
         "max_bytes_in_per_step": max(into),
     }
+    if all(counts.get("wall_seconds", 0) > 0 for counts in stepped):
+        walls = [counts["wall_seconds"] for counts in stepped]
+        bandwidth["bytes_out_per_wall_second"] = sum(s / w for s, w in zip(sent, walls, strict=True)) / len(walls)
+        bandwidth["bytes_in_per_wall_second"] = sum(
+            counts["bytes_received"] / w for counts, w in zip(stepped, walls, strict=True)
+        ) / len(walls)
+    return bandwidth
 
 
 def format_bandwidth(bandwidth: dict[str, Any], deltas: str) -> str:
@@ -154,6 +162,12 @@ def format_bandwidth(bandwidth: dict[str, Any], deltas: str) -> str:
         f"  bus per robot   out {bandwidth['bytes_out_per_step']:.0f} B, in {bandwidth['bytes_in_per_step']:.0f} B a step"
         f" (deltas as {'events' if deltas == 'event' else 'cells'}); at speed 1: out {8e-3 * bandwidth['bytes_out_per_second_at_speed_1']:.1f} kbit/s,"
         f" in {8e-3 * bandwidth['bytes_in_per_second_at_speed_1']:.1f} kbit/s"
+        + (
+            f"\n  bus this run    out {bandwidth['bytes_out_per_wall_second']:.0f} B/s, in "
+            f"{bandwidth['bytes_in_per_wall_second']:.0f} B/s per robot (wall clock, start to end)"
+            if "bytes_out_per_wall_second" in bandwidth
+            else ""
+        )
     )
 
 

@@ -88,6 +88,12 @@ def good_delta(**changes):
         (body(type="control", kind="explode", step=1, completed=False, e_d=0.0, reason=""), "bad-field"),
         (body(type="snapshot", rows=100, cols=100, map=b"not zlib", applied=[]), "undecodable"),
         (body(type="snapshot", rows=50, cols=100, map=b"", applied=[]), "out-of-range"),
+        (body(type="traffic", role="router", ident=0, seconds=1.0, out=0, **{"in": 0}), "bad-field"),
+        (body(type="traffic", role="agent", ident=4, seconds=1.0, out=0, **{"in": 0}), "out-of-range"),
+        (body(type="traffic", role="coordinator", ident=1, seconds=1.0, out=0, **{"in": 0}), "out-of-range"),
+        (body(type="traffic", role="agent", ident=0, seconds=-1.0, out=0, **{"in": 0}), "bad-field"),
+        (body(type="traffic", role="agent", ident=0, seconds=1.0, out=-5, **{"in": 0}), "out-of-range"),
+        (body(type="traffic", role="agent", ident=0, seconds=math.inf, out=0, **{"in": 0}), "not-finite"),
     ],
 )
 def test_malformed_payloads_are_rejected_with_a_reason(payload, reason):

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from protocol.inbox import Inbox
-from protocol.messages import RunControl, encode
+from protocol.messages import RunControl, Traffic, encode
 from tests.test_recovery import LIMITS, agent_step, delta, drain
 
 
@@ -23,6 +23,16 @@ def test_the_inbox_rejects_a_message_published_on_another_agents_key():
     inbox.deliver("anicov/t/agent/2/delta", encode(delta(1, 0)))
     assert drain(inbox) == []
     assert inbox.counts()["rejected.wrong-sender"] == 1
+
+
+def test_a_traffic_report_must_come_on_its_own_processes_key():
+    inbox = Inbox(LIMITS)
+    inbox.deliver("anicov/t/traffic/agent/2", encode(Traffic("agent", 1, 1.0, 10, 20)))
+    inbox.deliver("anicov/t/traffic/coordinator/0", encode(Traffic("agent", 0, 1.0, 10, 20)))
+    assert drain(inbox) == []
+    assert inbox.counts()["rejected.wrong-sender"] == 2
+    inbox.deliver("anicov/t/traffic/agent/1", encode(Traffic("agent", 1, 1.0, 10, 20)))
+    assert [item.message.ident for item in drain(inbox)] == [1]
 
 
 def test_the_drop_hook_drops_about_the_configured_fraction_and_counts_it():

@@ -12,6 +12,7 @@ from protocol.messages import (
     RunControl,
     Snapshot,
     StepGo,
+    Traffic,
     encode,
 )
 
@@ -84,3 +85,9 @@ def test_a_step_with_an_event_travels_compact_and_comes_back_whole():
     held = MapDelta(3, 1234, 0, 0, np.zeros((0, 0), np.int64))
     payload, back = compact_round_trip(held, state, limits)
     assert len(payload) == 82 and back.delta.ticks.shape == (0, 0) and back.delta.event is None
+
+
+def test_a_traffic_report_round_trips():
+    report = Traffic("agent", 3, 12.5, 10_250, 31_000)
+    assert decode(encode(report), LIMITS) == report
+    assert len(encode(report)) < 80  # one a second: well under 1 % of a robot's traffic

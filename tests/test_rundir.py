@@ -54,3 +54,18 @@ def test_bandwidth_is_per_robot_and_step_and_per_second_at_speed_one():
         format_bandwidth(bandwidth, "event")
     )
     assert bandwidth_of(counts[2:], dt=0.1) is None
+    assert "bytes_out_per_wall_second" not in bandwidth  # counts written before the wall clock was counted
+
+
+def test_bandwidth_counts_replies_to_teammates_and_the_wall_clock_rate():
+    from runtime.rundir import bandwidth_of, format_bandwidth
+
+    counts = [
+        {"steps": 100, "bytes_sent": 8000, "bytes_served": 2000, "bytes_received": 30000, "wall_seconds": 10.0},
+        {"steps": 100, "bytes_sent": 8000, "bytes_served": 0, "bytes_received": 10000, "wall_seconds": 5.0},
+    ]
+    bandwidth = bandwidth_of(counts, dt=0.1)
+    assert bandwidth["bytes_out_per_step"] == (100 + 80) / 2
+    assert bandwidth["bytes_out_per_wall_second"] == (1000 + 1600) / 2
+    assert bandwidth["bytes_in_per_wall_second"] == (3000 + 2000) / 2
+    assert "bus this run    out 1300 B/s, in 2500 B/s per robot" in format_bandwidth(bandwidth, "event")

@@ -7,6 +7,7 @@ import signal
 
 import pytest
 
+from logger.replay import summarise_recording
 from tests.teamrun import (
     anicov,
     check_realtime_run,
@@ -82,6 +83,21 @@ def test_realtime_clock_completes_within_15_percent_of_lockstep(tmp_path):
     ratio = summary["completion_time"] / lockstep["completion_time"]
     (tmp_path / "ratio.txt").write_text(f"{ratio:.3f}\n")
     assert 0.85 <= ratio <= 1.15, ratio
+    # Bandwidth you can see: every process's reports reached the logger and its recording, and the
+    # launcher measured each robot's bytes per wall second.
+    rt = tmp_path / "rt"
+    reported = json.loads((rt / "logs" / "logger.counts.json").read_text())["bandwidth"]
+    assert set(reported) == {"agent-0", "agent-1", "agent-2", "agent-3", "coordinator-0", "logger-0"}
+    for agent in range(4):
+        counts = json.loads((rt / "logs" / f"agent-{agent}.counts.json").read_text())
+        # the logger's last report of a robot is at most what the robot counted at its exit
+        assert 0 < reported[f"agent-{agent}"]["bytes_out"] <= counts["bytes_sent"] + counts["bytes_served"]
+        assert 0 < reported[f"agent-{agent}"]["bytes_in"] <= counts["bytes_received"]
+    series = summarise_recording(rt / "recording.rrd", load_maps=False).traffic
+    assert {("agent-0", "bytes_out"), ("coordinator-0", "bytes_in")} <= set(series)
+    assert all(rate >= 0 for rates in series.values() for rate in rates) and max(series[("agent-0", "bytes_out")]) > 0
+    bandwidth = json.loads((rt / "bandwidth.json").read_text())
+    assert bandwidth["bytes_out_per_wall_second"] > 0 and "bus this run" in launched.stdout
 
 
 @pytest.mark.parametrize(("number", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"])
@@ -126,7 +142,6 @@ def test_agent_with_bad_id_fails_with_a_clear_message():
 def test_a_team_on_a_map_equals_the_engine_and_its_recording_shows_the_map(tmp_path):
     import numpy as np
 
-    from logger.replay import summarise_recording
     from tests.conftest import write_map
 
     occupied = np.zeros((40, 40), dtype=bool)

@@ -8,12 +8,22 @@ import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from logger.replay import summarise_recording
+from logger.replay import format_recording_summary, summarise_recording
 from logger.team_logger import LoggerOptions, TeamLogger
 from model.scenario import Scenario
 from protocol.inbox import Membership, Received
 from protocol.keys import TeamKeys
-from protocol.messages import AgentState, AgentStep, MapDelta, Objectives, RunControl, Snapshot, StepGo, encode
+from protocol.messages import (
+    AgentState,
+    AgentStep,
+    MapDelta,
+    Objectives,
+    RunControl,
+    Snapshot,
+    StepGo,
+    Traffic,
+    encode,
+)
 
 SCENARIO = Scenario()  # the paper's: a 100 × 100 grid of unit cells, 4 agents, Λ* = 100
 ROWS, COLS = SCENARIO.grid_shape
@@ -146,6 +156,35 @@ def test_realtime_steps_membership_and_an_abort(tmp_path):
         (1, "WARN", "agent 1 left"),
         (1, "INFO", "run ended: coordinator lost"),
     ]
+
+
+def test_traffic_reports_become_bytes_per_second_and_a_table(tmp_path):
+    node, path = make_logger(tmp_path)
+    for report in (
+        Traffic("agent", 2, 1.0, 1_000, 5_000),
+        Traffic("agent", 2, 3.0, 3_000, 9_000),  # 1,000 B/s out, 2,000 B/s in over those 2 s
+        Traffic("coordinator", 0, 2.0, 500, 800),  # a first report: nothing to compare with yet
+        Traffic("agent", 2, 0.5, 100, 100),  # restarted: its counters start again, no negative rate
+        Traffic("agent", 2, 1.5, 600, 2_100),  # 500 B/s out, 2,000 B/s in since the restart
+    ):
+        node.handle(Received(f"anicov/t/traffic/{report.role}/{report.ident}", report))
+    node.finish()
+
+    content = summarise_recording(path)
+    assert content.traffic == {
+        ("agent-2", "bytes_out"): [1000.0, 500.0],
+        ("agent-2", "bytes_in"): [2000.0, 2000.0],
+    }
+    assert node.bandwidth()["agent-2"] == {
+        "seconds": 1.5,
+        "bytes_out": 600,
+        "bytes_in": 2_100,
+        "bytes_out_per_second": 400.0,
+        "bytes_in_per_second": 1400.0,
+    }
+    assert node.bandwidth()["coordinator-0"]["bytes_in_per_second"] == 400.0
+    assert "/run/bandwidth" in content.entities
+    assert "bus agent-2      out 750 B/s, in 2000 B/s" in format_recording_summary(content)
 
 
 def test_an_abort_without_a_reason_and_a_stop_before_the_end(tmp_path):
