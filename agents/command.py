@@ -47,7 +47,9 @@ def main(args: argparse.Namespace) -> int:
     scenario = scenario_from_arguments(args)
     if not 0 <= args.id < scenario.agents:
         raise ScenarioError(f"--id: expected an agent id from 0 to {scenario.agents - 1}, got {args.id}")
-    options = AgentOptions(args.team, args.id, args.clock, args.speed, args.drop_rate, args.counts, args.deltas)
+    options = AgentOptions(
+        args.team, args.id, args.clock, args.speed, args.drop_rate, args.counts, args.deltas, args.no_coordinator
+    )
     ros2 = ros2_options(args, scenario) if args.robot == "ros2" else None
     return run_agent(scenario, options, config_from_arguments(args), stop, ros2)
 

@@ -41,6 +41,7 @@ class AgentOptions:
     drop_rate: float = 0.0
     counts_file: str | None = None
     deltas: str = "event"  # how this agent's deltas travel: "event" or "cells" (protocol.events)
+    no_coordinator: bool = False  # a team without one (local planning, realtime): agree and start with the peers
 
 
 class AgentNode:

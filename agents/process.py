@@ -32,7 +32,14 @@ import zenoh
 
 from agents.node import AgentNode, AgentOptions
 from model.scenario import Scenario
-from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_digest, digest_of
+from protocol.agreement import (
+    ScenarioMismatch,
+    check_agreement,
+    coordinator_digest,
+    digest_of,
+    peer_digests,
+    serve_digest,
+)
 from protocol.messages import AgentState, AgentStep, MapDelta, encode
 from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
 from protocol.session import RouterUnreachable, open_session, team_publisher, zenoh_config
@@ -96,7 +103,8 @@ def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: 
     bus = declare_endpoints(session, node, lockstep)
     traffic = TrafficReporter(session, node.keys.traffic("agent", options.agent), "agent", options.agent, bus.traffic)
     try:
-        if not wait_for_agreement(bus, stop, parent):
+        agreed = wait_for_peers(bus, stop, parent) if options.no_coordinator else wait_for_agreement(bus, stop, parent)
+        if not agreed:
             bus.token.undeclare()
             return exit_code(node, stop)
     except ScenarioMismatch as error:
@@ -104,11 +112,14 @@ def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: 
         bus.token.undeclare()
         return EXIT_USAGE
     traffic.start()
-    if resume_from_snapshot(session, node):
-        # Lockstep: it says hello like a new robot, and the coordinator lists it again from its next go.
-        node.rejoining = lockstep
-        log.info("agent %d resumes from the coordinator's snapshot after step %d", options.agent, node.step - 1)
-    wait_until_admitted(bus, stop, parent)
+    if options.no_coordinator:
+        start_without_coordinator(bus)
+    else:
+        if resume_from_snapshot(session, node):
+            # Lockstep: it says hello like a new robot, and the coordinator lists it again from its next go.
+            node.rejoining = lockstep
+            log.info("agent %d resumes from the coordinator's snapshot after step %d", options.agent, node.step - 1)
+        wait_until_admitted(bus, stop, parent)
     log.info("agent %d starts (%s clock)", options.agent, options.clock)
     try:
         if lockstep:
@@ -169,6 +180,7 @@ def declare_endpoints(session: zenoh.Session, node: AgentNode, lockstep: bool) -
     token = session.liveliness().declare_token(keys.alive("agent", agent))
     settle_garbage_collector()
 
+    serve_digest(session, keys.agent_scenario(agent), digest_of(node.scenario))  # for a team with no coordinator
     history = History(keys.agent_history(agent), capacity=node.radio.history_steps())
     session.declare_queryable(keys.agent_history(agent), history.serve)
     sync = None
@@ -220,6 +232,32 @@ def wait_for_agreement(bus: Bus, stop: StopFlag, parent: int) -> bool:
         if parent_is_gone(parent):
             return False
     return False
+
+
+def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
+    """No coordinator: wait until every agent of the team answers with this agent's scenario and map
+    (ScenarioMismatch at the first that does not). False: stopped, or the launcher is gone, before."""
+    node = bus.node
+    mine = digest_of(node.scenario)
+    while not stop.stopped:
+        found = peer_digests(bus.session, node.keys, node.limits, timeout=HELLO_PERIOD)
+        for agent, theirs in sorted(found.items()):
+            check_agreement(mine, theirs, node.scenario, whose=f"agent {agent}'s")
+        if len(found) == node.scenario.agents:
+            return True
+        if parent_is_gone(parent):
+            return False
+    return False
+
+
+def start_without_coordinator(bus: Bus) -> None:
+    """No coordinator: every teammate is there and agrees, so the run starts now. The hello tells the
+    teammates (and a logger) where this robot starts; local planning gives it its first objective."""
+    node = bus.node
+    node.load_kernels()
+    bus.step_publisher.put(encode(node.hello()))
+    node.started = True
+    log.info("agent %d: all %d agents agree; starting without a coordinator", node.options.agent, node.scenario.agents)
 
 
 def wait_until_admitted(bus: Bus, stop: StopFlag, parent: int) -> None:

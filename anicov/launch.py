@@ -125,7 +125,7 @@ def child_command(role: str, args: argparse.Namespace, extra: list[str], identit
     ):
         if value is not None:
             command += [flag, str(value)]
-    return command + extra
+    return command + ["--no-coordinator"] * bool(args.no_coordinator) + extra
 
 
 def spawn(role: str, command: list[str], logs: Path) -> Child:
@@ -253,9 +253,13 @@ def main(argv: list[str] | None = None) -> int:
         router.declare_subscriber(keys.status, watch.on_sample)
         coordinator_command = start_team(args, scenario.agents, out_dir, children)
         try:
-            seen = supervise(
-                children, coordinator_command, logs, watch, scenario, args.quiet, stop, args.coordinator_restarts
-            )
+            if args.no_coordinator:  # local planning: the robots start, plan and end the run themselves
+                agent_children = [child for child in children if child.role.startswith("agent-")]
+                seen = Supervision(coordinator_lost=True, exit_code=wait_for_agents(agent_children, stop))
+            else:
+                seen = supervise(
+                    children, coordinator_command, logs, watch, scenario, args.quiet, stop, args.coordinator_restarts
+                )
         finally:
             if not stop.stopped:
                 # After the end of the run every child leaves by itself (the logger flushes first).
@@ -265,7 +269,7 @@ def main(argv: list[str] | None = None) -> int:
     if stop.stopped:
         print(f"launch_team: stopped by signal; every child stopped. Logs in {logs}", file=sys.stderr)
         return stop.exit_code(EXIT_FAILED)
-    return report(args, scenario.agents, out_dir, children, seen, time.monotonic() - started)
+    return report(args, scenario.agents, out_dir, children, seen, time.monotonic() - started, scenario.dt)
 
 
 def apply_secure_profile(args: argparse.Namespace, agents: int) -> str | None:
@@ -294,7 +298,8 @@ def start_team(args: argparse.Namespace, agents: int, out_dir: Path, children: l
     coordinator_command = child_command(
         "coordinator", args, ["--out", str(out_dir)] + ["--await-logger"] * bool(recording)
     )
-    children.append(spawn("coordinator", coordinator_command, logs))
+    if not args.no_coordinator:
+        children.append(spawn("coordinator", coordinator_command, logs))
     if recording:
         logger_flags = ["--out", str(out_dir / "recording.rrd"), "--map-every", str(args.map_every)]
         logger_flags += ["--recording-id", f"{args.team}-{out_dir.name}"]
@@ -369,25 +374,43 @@ def supervise(
 
 
 def report_without_coordinator(
-    agents: int, out_dir: Path, children: list[Child], seen: Supervision, wall: float
+    args: argparse.Namespace,
+    agents: int,
+    out_dir: Path,
+    children: list[Child],
+    seen: Supervision,
+    wall: float,
+    dt: float,
 ) -> int:
-    """Local planning after the coordinator was killed for good: what the robots did (no summary.json:
-    the coordinator writes it; the recording has the run)."""
+    """Local planning after the coordinator was killed for good, or with none started: what the robots did
+    (no summary.json: the coordinator writes it; the recording has the run)."""
     from runtime.rundir import read_counts
 
     logs = out_dir / "logs"
     done = [child.role for child in children if child.role.startswith("agent-") and child.process.returncode == 0]
-    print(f"launch_team: the coordinator was killed and not restarted; local planning: {len(done)} of {agents} robots")
+    how = "was not started (--no-coordinator)" if args.no_coordinator else "was killed and not restarted"
+    print(f"launch_team: the coordinator {how}; local planning: {len(done)} of {agents} robots")
     print("  ended the run on their own, each with a complete replica" if len(done) == agents else "  ended the run")
-    for agent in range(agents):
-        counts = read_counts(logs / f"agent-{agent}.counts.json") or {}
+    every_counts = [read_counts(logs / f"agent-{agent}.counts.json") or {} for agent in range(agents)]
+    for agent, counts in enumerate(every_counts):
         print(
             f"  agent {agent}         e_D of its replica {counts.get('domain_error', '-')}, steps {counts.get('steps', '-')}"
         )
     if (out_dir / "recording.rrd").exists():
         print(f"  recording       {out_dir / 'recording.rrd'}   (no summary.json: the coordinator writes it)")
+    report_bandwidth([counts for counts in every_counts if counts], dt, args.deltas, out_dir)
     print(f"  wall time       {wall:.1f} s")
     return seen.exit_code
+
+
+def report_bandwidth(agent_counts: list[dict], dt: float, deltas: str, out_dir: Path) -> None:
+    """Each robot's bytes on the bus (runtime.rundir.bandwidth_of): printed and kept in bandwidth.json."""
+    from runtime.rundir import bandwidth_of, format_bandwidth
+
+    bandwidth = bandwidth_of(agent_counts, dt)
+    if bandwidth is not None:
+        (out_dir / "bandwidth.json").write_text(json.dumps(bandwidth | {"deltas": deltas}, indent=2) + "\n")
+        print(format_bandwidth(bandwidth, deltas))
 
 
 def wait_for_agents(agents: list[Child], stop: StopFlag) -> int:
@@ -399,15 +422,21 @@ def wait_for_agents(agents: list[Child], stop: StopFlag) -> int:
 
 
 def report(
-    args: argparse.Namespace, agents: int, out_dir: Path, children: list[Child], seen: Supervision, wall: float
+    args: argparse.Namespace,
+    agents: int,
+    out_dir: Path,
+    children: list[Child],
+    seen: Supervision,
+    wall: float,
+    dt: float,
 ) -> int:
     """The one-screen summary of a finished run (or what failed), and the launcher's exit code."""
     logs = out_dir / "logs"
     summary_path = out_dir / "summary.json"
     if seen.coordinator_lost:
-        return report_without_coordinator(agents, out_dir, children, seen, wall)
+        return report_without_coordinator(args, agents, out_dir, children, seen, wall, dt)
     if seen.exit_code in (EXIT_OK, EXIT_INCOMPLETE) and summary_path.exists():
-        from runtime.rundir import bandwidth_of, format_bandwidth, format_summary, read_counts
+        from runtime.rundir import format_summary, read_counts
 
         summary = json.loads(summary_path.read_text())
         print(format_summary(summary, out_dir).replace("anicov run:", f"launch_team ({args.clock}, over Zenoh):"))
@@ -426,10 +455,7 @@ def report(
         agent_counts = [
             counts for agent in range(agents) if (counts := read_counts(logs / f"agent-{agent}.counts.json"))
         ]
-        bandwidth = bandwidth_of(agent_counts, summary["scenario"]["dt"])
-        if bandwidth is not None:
-            (out_dir / "bandwidth.json").write_text(json.dumps(bandwidth | {"deltas": args.deltas}, indent=2) + "\n")
-            print(format_bandwidth(bandwidth, args.deltas))
+        report_bandwidth(agent_counts, dt, args.deltas, out_dir)
         if (out_dir / "recording.rrd").exists():
             print(f"  recording       {out_dir / 'recording.rrd'}   (anicov replay {out_dir / 'recording.rrd'})")
         print(f"  wall time       {wall:.1f} s")

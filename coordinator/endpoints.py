@@ -36,7 +36,7 @@ class CoordinatorBus:
         session.declare_subscriber(keys.all_steps, node.inbox.on_sample)
         session.liveliness().declare_subscriber(keys.alive_agents, node.inbox.on_liveliness, history=True)
         session.declare_queryable(keys.snapshot, lambda query: query.reply(keys.snapshot, node.snapshot_payload()))
-        serve_digest(session, keys, digest_of(node.scenario))  # processes check they run what it runs
+        serve_digest(session, keys.scenario, digest_of(node.scenario))  # processes check they run what it runs
         objectives = team_publisher(session, keys.objectives)
         go = team_publisher(session, keys.go)
         go_history = History(keys.go_history)

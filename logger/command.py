@@ -51,5 +51,6 @@ def main(args: argparse.Namespace) -> int:
         args.clock,
         args.web_port,
         args.grpc_port,
+        args.no_coordinator,
     )
     return run_logger(scenario, options, config_from_arguments(args), stop)

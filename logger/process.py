@@ -21,7 +21,7 @@ import zenoh
 from logger.team_logger import LoggerOptions, TeamLogger
 from model.exact_coverage import load_kernels as load_event_kernel
 from model.scenario import Scenario
-from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_digest, digest_of
+from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_digest, digest_of, peer_digests
 from protocol.keys import TeamKeys
 from protocol.recovery import fetch, fetch_snapshot
 from protocol.session import open_session
@@ -55,14 +55,16 @@ def run_logger(scenario: Scenario, options: LoggerOptions, config: zenoh.Config,
         # The snapshot before the liveliness token: a run started with --await-logger waits for the token,
         # so every go of a fresh run comes after this snapshot (a loaded machine once let a run's first
         # steps into it, and the logger skipped their gos); a late logger starts from the map as it is.
-        _load_snapshot(session, keys, node)
+        if not options.no_coordinator:
+            _load_snapshot(session, keys, node)
         token = session.liveliness().declare_token(keys.alive("logger"))
         settle_garbage_collector()
         load_event_kernel(node.limits.kernel)  # it decodes every event of the team
         read_gos = partial(_read_gos, session, keys, node) if lockstep else None
-        _follow(node, read_gos, lambda: stop.stopped or parent_is_gone(parent))
+        ended = node.everyone_left if options.no_coordinator else lambda: False
+        _follow(node, read_gos, lambda: stop.stopped or parent_is_gone(parent) or ended())
         _drain(node, read_gos)
-        if node.finished is not None and not node.replica.map.complete:
+        if node.finished is not None and not node.replica.map.complete and not options.no_coordinator:
             _load_snapshot(session, keys, node)  # anything lost on the way: the coordinator's map is the reference
         token.undeclare()
     node.finish()
@@ -79,9 +81,17 @@ def _subscribe(session: zenoh.Session, keys: TeamKeys, node: TeamLogger, lockste
 
 
 def _await_agreement(session: zenoh.Session, keys: TeamKeys, node: TeamLogger, stopped: Callable[[], bool]) -> None:
-    """Until the coordinator answers: it must run this logger's scenario and map (ScenarioMismatch)."""
+    """Until the coordinator (with no coordinator: the first agents) answers: it must run this logger's
+    scenario and map (ScenarioMismatch)."""
     mine = digest_of(node.scenario)
     while not stopped():
+        if node.options.no_coordinator:
+            found = peer_digests(session, keys, node.limits, timeout=0.2)
+            for agent, theirs in sorted(found.items()):
+                check_agreement(mine, theirs, node.scenario, whose=f"agent {agent}'s")
+            if found:
+                return
+            continue
         theirs = coordinator_digest(session, keys, node.limits, timeout=0.2)
         if theirs is not None:
             check_agreement(mine, theirs, node.scenario)

@@ -32,11 +32,13 @@ class LoggerOptions:
     clock: str = "lockstep"
     web_port: int = 9090
     grpc_port: int = 9876
+    no_coordinator: bool = False  # a team without one: agree with the agents, end when they have all left
 
 
 class TeamLogger:
     def __init__(self, scenario: Scenario, options: LoggerOptions) -> None:
         self.scenario = scenario
+        self.options = options
         self.limits = Limits.of(scenario)
         self.replica = MapReplica.of(scenario)
         self.inbox = Inbox(self.limits, defer_decoding=True)
@@ -56,10 +58,17 @@ class TeamLogger:
         self.finished: RunControl | None = None
         self.next_go = 0  # lockstep: the first go not read yet
         self.traffic: dict[str, Traffic] = {}  # each process's latest report
+        self.joined: set[int] = set()  # agents whose liveliness token was seen
+        self.alive: set[int] = set()
         self.started = time.monotonic()  # the logger's own traffic: what its inbox took in since
 
     def handle(self, item: Received | Membership) -> None:
         if isinstance(item, Membership):
+            if item.alive:
+                self.joined.add(item.agent)
+                self.alive.add(item.agent)
+            else:
+                self.alive.discard(item.agent)
             self.recorder.event(
                 max(self.latest_step, 0),
                 f"agent {item.agent} {'joined' if item.alive else 'left'}",
@@ -112,6 +121,10 @@ class TeamLogger:
                 "bytes_in_per_second": round(report.bytes_in * per, 1),
             }
         return table
+
+    def everyone_left(self) -> bool:
+        """Every agent of the team was seen and is gone (a team with no coordinator has ended)."""
+        return len(self.joined) == self.scenario.agents and not self.alive
 
     def take_go(self, go: StepGo) -> None:
         """Lockstep: the whole previous step in one message."""

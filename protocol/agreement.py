@@ -18,7 +18,7 @@ import zenoh
 from model.scenario import Scenario
 from model.world import world_of
 from protocol.decoding import decode
-from protocol.keys import TeamKeys
+from protocol.keys import TeamKeys, agent_of_key
 from protocol.messages import Limits, ProtocolError, ScenarioDigest, encode
 
 log = logging.getLogger("anicov.agreement")
@@ -38,10 +38,28 @@ def digest_of(scenario: Scenario) -> ScenarioDigest:
     return ScenarioDigest(hashlib.sha256(text.encode()).hexdigest(), world.map_sha256)
 
 
-def serve_digest(session: zenoh.Session, keys: TeamKeys, digest: ScenarioDigest) -> zenoh.Queryable:
-    """The coordinator's side: answer every ask with its digest."""
+def serve_digest(session: zenoh.Session, key: str, digest: ScenarioDigest) -> zenoh.Queryable:
+    """Answer every ask on ``key`` (the coordinator's, or an agent's own) with this process's digest."""
     payload = encode(digest)
-    return session.declare_queryable(keys.scenario, lambda query: query.reply(keys.scenario, payload))
+    return session.declare_queryable(key, lambda query: query.reply(key, payload))
+
+
+def peer_digests(session: zenoh.Session, keys: TeamKeys, limits: Limits, timeout: float) -> dict[int, ScenarioDigest]:
+    """A team with no coordinator: the digest of every agent that answers on agent/<id>/scenario."""
+    found: dict[int, ScenarioDigest] = {}
+    for reply in session.get(keys.all_agent_scenarios, timeout=timeout):
+        if reply.ok is None:
+            continue
+        agent = agent_of_key(str(reply.ok.key_expr))
+        try:
+            message = decode(reply.ok.payload.to_bytes(), limits, expected="scenario")
+        except ProtocolError as error:
+            log.warning("rejected a teammate's scenario digest: %s", error)
+            continue
+        if agent is not None and 0 <= agent < limits.agents:
+            assert isinstance(message, ScenarioDigest)
+            found[agent] = message
+    return found
 
 
 def coordinator_digest(session: zenoh.Session, keys: TeamKeys, limits: Limits, timeout: float) -> ScenarioDigest | None:
@@ -59,16 +77,18 @@ def coordinator_digest(session: zenoh.Session, keys: TeamKeys, limits: Limits, t
     return None
 
 
-def check_agreement(mine: ScenarioDigest, theirs: ScenarioDigest, scenario: Scenario) -> None:
-    """Raise ScenarioMismatch unless the coordinator runs what this process loaded."""
+def check_agreement(
+    mine: ScenarioDigest, theirs: ScenarioDigest, scenario: Scenario, whose: str = "the coordinator's"
+) -> None:
+    """Raise ScenarioMismatch unless the coordinator (or ``whose`` process) runs what this process loaded."""
     if mine == theirs:
         return
     if mine.map_sha256 != theirs.map_sha256:
         raise ScenarioMismatch(
-            f"map {scenario.map or '(none)'} has sha256 {mine.map_sha256[:16] or '-'}..., the coordinator's "
+            f"map {scenario.map or '(none)'} has sha256 {mine.map_sha256[:16] or '-'}..., {whose} "
             f"map has {theirs.map_sha256[:16] or '-'}...: give every process the same map files"
         )
     raise ScenarioMismatch(
-        f"scenario digest {mine.scenario[:16]}... differs from the coordinator's {theirs.scenario[:16]}...: "
+        f"scenario digest {mine.scenario[:16]}... differs from {whose} {theirs.scenario[:16]}...: "
         "give every process the same scenario file and overrides (--n, --seed, --controller)"
     )

@@ -9,6 +9,8 @@ agent/<id>/relay            (queryable)          agent               realtime: t
                                                                      for one that died (?agent=<id>;steps=…)
 agent/<id>/sync             (queryable)          agent               comm_range: anti-entropy, ?have=<c0>,<c1>,…
                                                                      → every step it holds beyond those counts
+agent/<id>/scenario         (queryable)          agent               ScenarioDigest: what it runs (for a team
+                                                                     with no coordinator: peers check each other)
 coordinator/go              StepGo               coordinator → all   lockstep: step k may start, with every
                                                                      step k−1 delta and state, targets on replans
 coordinator/objectives      Objectives           coordinator → all   realtime: the latest targets
@@ -63,6 +65,13 @@ class TeamKeys:
 
     def agent_sync(self, agent: int) -> str:
         return f"{self.prefix}/agent/{agent}/sync"
+
+    def agent_scenario(self, agent: int) -> str:
+        return f"{self.prefix}/agent/{agent}/scenario"
+
+    @property
+    def all_agent_scenarios(self) -> str:
+        return f"{self.prefix}/agent/*/scenario"
 
     @property
     def coordinator_relay(self) -> str:

@@ -38,6 +38,12 @@ def add_team_arguments(parser: argparse.ArgumentParser) -> None:
         default=10.0,
         help="realtime only: simulated time units per wall-clock second (default 10)",
     )
+    parser.add_argument(
+        "--no-coordinator",
+        action="store_true",
+        help='a team without a coordinator process: needs planning = "local" and --clock realtime; the agents '
+        "check each other's scenario, start when all are there and end the run themselves",
+    )
 
 
 def add_process_arguments(parser: argparse.ArgumentParser) -> None:
@@ -68,8 +74,24 @@ def scenario_from_arguments(args: argparse.Namespace) -> Scenario:
             f"scenario key 'comm_range' ({scenario.comm_range}): a limited radio needs --clock realtime on the bus "
             "(lockstep steps travel in the coordinator's go); leave comm_range out, or run it with anicov run"
         )
+    if getattr(args, "no_coordinator", False):
+        check_no_coordinator(scenario, getattr(args, "clock", None))
     check_world(scenario)
     return scenario
+
+
+def check_no_coordinator(scenario: Scenario, clock: str | None) -> None:
+    """A team with no coordinator: each robot must plan for itself, on the wall clock (lockstep's step
+    is the coordinator's go)."""
+    if scenario.planning != "local":
+        raise ScenarioError(
+            f"--no-coordinator: scenario key 'planning' must be \"local\" (got {scenario.planning!r}): "
+            "with central planning the coordinator chooses every objective"
+        )
+    if clock != "realtime":
+        raise ScenarioError(
+            f"--no-coordinator: expected --clock realtime, got {clock}: a lockstep step is the coordinator's go"
+        )
 
 
 def check_world(scenario: Scenario) -> None:

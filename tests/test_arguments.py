@@ -51,3 +51,14 @@ def test_every_process_takes_the_same_team_and_bus_flags(part):
         "lockstep",
         10.0,
     )
+
+
+def test_a_team_without_a_coordinator_needs_local_planning_and_the_wall_clock(tmp_path):
+    local = tmp_path / "local.toml"
+    local.write_text('planning = "local"\n')
+    with pytest.raises(ScenarioError, match="--no-coordinator: scenario key 'planning' must be \"local\""):
+        scenario_from_arguments(parse(add_process_arguments, "--no-coordinator", "--clock", "realtime"))
+    with pytest.raises(ScenarioError, match="--no-coordinator: expected --clock realtime, got lockstep"):
+        scenario_from_arguments(parse(add_process_arguments, "--no-coordinator", "--config", str(local)))
+    args = parse(add_process_arguments, "--no-coordinator", "--config", str(local), "--clock", "realtime")
+    assert scenario_from_arguments(args).planning == "local"

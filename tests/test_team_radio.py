@@ -8,6 +8,7 @@ import os
 import signal
 import time
 
+from logger.replay import summarise_recording
 from tests.teamrun import (
     anicov,
     launched_team,
@@ -88,4 +89,33 @@ def test_local_planning_finishes_the_run_after_the_coordinator_is_killed(tmp_pat
         "no coordinator ended the run: it ends" in (out / "logs" / f"agent-{i}.log").read_text() for i in range(4)
     )
     assert (out / "recording.rrd").stat().st_size > 0 and not (out / "summary.json").exists()
+    assert processes_of(team) == []
+
+
+def test_a_team_started_without_a_coordinator_covers_and_ends_with_one_map(tmp_path):
+    """--no-coordinator: the agents check each other's scenario, start when all four agree, plan for
+    themselves, end when their replicas are complete; every replica ends the same map, the logger records
+    the run and leaves when the robots have."""
+    config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=4, seed=3, planning="local")
+    team = unique_team()
+    out = tmp_path / "team"
+    command = launcher_command(
+        "--config", str(config), "--out", str(out), "--clock", "realtime", "--speed", "10", "--no-coordinator",
+        team=team,
+    )  # fmt: skip
+    launched = run(command, timeout=400)
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "the coordinator was not started (--no-coordinator)" in launched.stdout
+    assert "ended the run on their own" in launched.stdout
+    counts = agent_counts(out, 4)
+    assert all(count["domain_error"] == 0.0 for count in counts)
+    assert len({count["map_digest"] for count in counts}) == 1
+    assert not (out / "logs" / "coordinator.log").exists() and not (out / "summary.json").exists()
+    logger_log = (out / "logs" / "logger.log").read_text()
+    assert "Traceback" not in logger_log
+    recorded = summarise_recording(out / "recording.rrd", load_maps=False)
+    assert recorded.agents == [0, 1, 2, 3] and ("agent-0", "bytes_out") in recorded.traffic
+    assert (
+        "bus per robot" in launched.stdout and json.loads((out / "bandwidth.json").read_text())["agents_counted"] == 4
+    )
     assert processes_of(team) == []
