@@ -24,7 +24,7 @@ from anicov.run_parts import finish_run, objective_fields
 from model.coverage_map import CoverageMap, add_window
 from model.ground import Ground, open_ground
 from model.parameters import coverage_map_of, law_parameters, safety_parameters, starting_poses
-from model.planning import Plan, Planner
+from model.planning import Plan, planner_for
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack, snapshot_steps
 from model.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
@@ -110,8 +110,8 @@ def run_scenario(
         return run_ranged(scenario, coverage_map, poses, record_trace, progress)
     law, world = law_parameters(scenario, coverage_map), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
-    planner = Planner(scenario)
-    block = scenario.replan_steps
+    planner = planner_for(scenario)
+    block = scenario.plan_steps
     agents = scenario.agents
     traces: list[np.ndarray] = []
     errors: list[np.ndarray] = [np.array([coverage_map.domain_error()])]

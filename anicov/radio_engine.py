@@ -20,7 +20,7 @@ import numpy as np
 from anicov.run_parts import finish_run, objective_fields
 from model.coverage_map import CoverageMap
 from model.parameters import law_parameters, safety_parameters
-from model.planning import Plan, Planner
+from model.planning import Plan, TeamPlanner, planner_for
 from model.radio import contacts, divergence, local_members, merge_knowledge
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack
 from model.safety import MEMORY_SIZE, SafetyParameters, filter_command
@@ -94,8 +94,8 @@ def run_ranged(
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     agents = scenario.agents
     team = RadioTeam(coverage_map, agents)
-    central = Planner(scenario)
-    planners = [Planner(scenario) for _ in range(agents)]
+    central = planner_for(scenario)
+    planners = [planner_for(scenario) for _ in range(agents)]
     rows: list[np.ndarray] = []
     flags: list[np.ndarray] = []
     errors = [coverage_map.domain_error()]
@@ -108,7 +108,7 @@ def run_ranged(
     while step < scenario.max_steps and not coverage_map.complete:
         positions = poses[:, :2].copy()
         in_contact = contacts(positions, scenario.comm_range)
-        if step % scenario.replan_steps == 0:
+        if step % scenario.plan_steps == 0:
             objectives = plan_objectives(scenario, team, central, planners, positions, in_contact)
             fields = objective_fields(world, objectives)
             if record_trace:
@@ -175,8 +175,8 @@ def decide_team(
 def plan_objectives(
     scenario: Scenario,
     team: RadioTeam,
-    central: Planner,
-    planners: list[Planner],
+    central: TeamPlanner,
+    planners: list[TeamPlanner],
     positions: np.ndarray,
     in_contact: np.ndarray,
 ) -> np.ndarray:
@@ -192,7 +192,7 @@ def plan_objectives(
     return objectives
 
 
-def record_plan(scenario: Scenario, central: Planner, step: int, objectives: np.ndarray) -> Plan:
+def record_plan(scenario: Scenario, central: TeamPlanner, step: int, objectives: np.ndarray) -> Plan:
     """The plan as the recording keeps it; local planning has no one team's blobs to draw."""
     if scenario.planning == "central":
         return central.record(step, objectives)

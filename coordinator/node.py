@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from coordinator.run_log import RunLog
-from model.planning import Planner
+from model.planning import planner_for
 from model.run import RunResult, snapshot_steps
 from model.scenario import Scenario
 from protocol.inbox import Inbox, Membership, Received
@@ -45,7 +45,7 @@ class Coordinator:
         self.keys = TeamKeys(options.team)
         self.limits = Limits.of(scenario)
         self.replica = MapReplica.of(scenario)
-        self.planner = Planner(scenario)
+        self.planner = planner_for(scenario)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=999)
         self.alive: set[int] = set()
         self.members: set[int] = set()
@@ -159,7 +159,7 @@ class Coordinator:
 
     def plan_if_due(self, step: int) -> Objectives | None:
         """Objectives for a go: on a replanning step or after a change of members, else None."""
-        if step % self.scenario.replan_steps == 0 or self.membership_changed:
+        if step % self.scenario.plan_steps == 0 or self.membership_changed:
             return self.plan(step)
         return None
 
@@ -177,7 +177,7 @@ class Coordinator:
         members = sorted(self.members)
         positions = np.array([self.positions[agent] for agent in members], dtype=np.float64).reshape(-1, 2)
         if members and (
-            step % self.scenario.replan_steps == 0 or self.membership_changed or len(self.targets) != len(members)
+            step % self.scenario.plan_steps == 0 or self.membership_changed or len(self.targets) != len(members)
         ):
             self.targets = self.planner.plan(self.replica.map.lack_of_coverage(), positions, members)
             self.membership_changed = False

@@ -79,7 +79,7 @@ def replay(
         for state in states.get(step, []):
             node.log.record(state)
             node.positions[state.agent] = (state.pose[0], state.pose[1])
-        if node.lockstep and step % node.scenario.replan_steps == 0:
+        if node.lockstep and step % node.scenario.plan_steps == 0:
             node.plan(step)
         for state in states.get(step, []):
             node.latest_state_step[state.agent] = step

@@ -103,7 +103,7 @@ class Stepping:
             self.bus.publish(
                 self.bus.objectives, Objectives(self.step, plan.members, plan.targets, plan.blobs, plan.labels)
             )
-            self.next_plan = now + scenario.replan_period / self.speed
+            self.next_plan = now + scenario.plan_steps * scenario.dt / self.speed
 
     def status_if_due(self) -> None:
         now = time.monotonic()

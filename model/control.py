@@ -72,6 +72,21 @@ def global_law_around_walls(
 
 
 @njit(cache=True)
+def pursuit_law(
+    x: float, y: float, theta: float, objective_x: float, objective_y: float, k_v: float, k_omega: float, dt: float
+) -> tuple[float, float]:
+    """Beyond the paper, the ``anicov`` controller (docs/controller.md): drive at the objective, a carrot
+    on the planned path (pure pursuit, Coulter 1992), at full speed until the carrot is within one step,
+    with eq. 15-16's heading terms: v = k_v min(1, d/(k_v dt)) (1 − 2|e_θ|/π), ω = k_ω e_θ, e_θ the
+    wrapped heading error to the carrot, d its distance. |v| ≤ k_v and |ω| ≤ π k_ω, the paper's bounds."""
+    dx = objective_x - x
+    dy = objective_y - y
+    e_theta = wrap_angle(math.atan2(dy, dx) - theta)
+    arrive = min(1.0, math.sqrt(dx * dx + dy * dy) / (k_v * dt))
+    return k_v * arrive * (1.0 - (2.0 / math.pi) * abs(e_theta)), k_omega * e_theta
+
+
+@njit(cache=True)
 def combined_law(
     theta: float,
     e_omega: float,

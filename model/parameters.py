@@ -33,6 +33,7 @@ def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParamete
         target_ticks=coverage_map.target_ticks,
         literal_heading=scenario.controller == "paper-literal",
         literal_omega=scenario.controller in ("paper-literal", "paper-eq16"),
+        pursuit=scenario.controller == "anicov",
     )
 
 

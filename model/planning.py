@@ -11,6 +11,7 @@ import numpy as np
 
 from model.assignment import assign_objectives
 from model.geodesic import path_length
+from model.lane_planner import LanePlanner
 from model.objectives import BlobObjectives, fallback_objective, select_objectives
 from model.reachability import nearest_reachable
 from model.scenario import Scenario
@@ -73,3 +74,14 @@ def path_lengths(world: World, positions: np.ndarray, objectives: np.ndarray) ->
                 field, ground.occupied, x, y, goal_x, goal_y, cell, ground.plan_radius, ground.bounded, lengths[i, j]
             )
     return lengths
+
+
+TeamPlanner = Planner | LanePlanner
+"""Either planning; both answer plan(lack, positions, members), labels() and record(step, targets)."""
+
+
+def planner_for(scenario: Scenario) -> TeamPlanner:
+    """The planning of a scenario's controller: Algorithms 1-2, or the anicov controller's lanes."""
+    if scenario.controller == "anicov":
+        return LanePlanner(scenario)
+    return Planner(scenario)

@@ -17,11 +17,21 @@ from model.scenario_safety import SAFETY_DEFAULTS, SafetyKeyError, check_safety,
 from model.scenario_terrain import resolve_terrain_keys
 from model.terrain import TerrainError
 
-CONTROLLERS = ("paper", "paper-literal", "paper-eq16", "zigzag", "boustrophedon")
+CONTROLLERS = ("paper", "paper-literal", "paper-eq16", "zigzag", "boustrophedon", "anicov")
 """``paper``: the chosen readings of eq. 11 and 16; ``paper-literal``: both as printed; ``paper-eq16``: eq. 11
 read toward the objective but eq. 16 as printed; ``zigzag``: Fig. 8 (docs/paper-notes.md), the lanes split in
 contiguous blocks; ``boustrophedon``: the same path cut into N pieces of equal length, each flown by the robot
-whose start is nearest in the team's least total transit (:func:`model.zigzag.boustrophedon_pilots`)."""
+whose start is nearest in the team's least total transit (:func:`model.zigzag.boustrophedon_pilots`);
+``anicov``: beyond the paper, lanes at the sensor's best spacing then passes over what is left, steered by
+carrots (:mod:`model.lane_planner`, docs/controller.md)."""
+CARROT_PERIOD = 0.5
+"""The anicov controller: time units between two carrots of one robot (model.lane_planner)."""
+BEST_CONTROLLER = "anicov"
+"""What ``controller = "best"`` (``--controller best``) names: the best controller the project has
+(docs/controller.md has the comparison). A run records the name it resolved to."""
+CONTROLLER_CHOICES = (*CONTROLLERS, "best")
+WITHOUT_WALLS = ("zigzag", "boustrophedon", "anicov")
+"""Controllers whose paths know no walls or robot bodies."""
 
 
 PAPER_SCENARIO = Path(__file__).resolve().parent.parent / "scenarios" / "paper.toml"
@@ -91,6 +101,14 @@ class Scenario:
     @property
     def replan_steps(self) -> int:
         return max(1, round(self.replan_period / self.dt))
+
+    @property
+    def plan_steps(self) -> int:
+        """Steps between two plans: replan_period's (Algorithms 1-2), or the anicov controller's carrot
+        period (model.lane_planner.CARROT_PERIOD, 0.5 time units)."""
+        if self.controller == "anicov":
+            return max(1, round(CARROT_PERIOD / self.dt))
+        return self.replan_steps
 
     def to_dict(self) -> dict[str, Any]:
         """The scenario as a file would state it; terrain keys only when they differ from the open
@@ -198,11 +216,11 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
                 raise ScenarioError(f"scenario key 'seed': expected a non-negative integer, got {value}")
             resolved[key] = value
         elif key == "controller":
-            if value not in CONTROLLERS:
+            if value not in CONTROLLER_CHOICES:
                 raise ScenarioError(
-                    f"scenario key 'controller': expected one of {', '.join(CONTROLLERS)}, got {value!r}"
+                    f"scenario key 'controller': expected one of {', '.join(CONTROLLER_CHOICES)}, got {value!r}"
                 )
-            resolved[key] = value
+            resolved[key] = BEST_CONTROLLER if value == "best" else value
         elif key == "half_angle_deg":
             angle = _number(key, value)
             if not 0.0 < angle < 180.0:
@@ -218,7 +236,7 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
 
 def _check_whole(scenario: Scenario) -> Scenario:
     """The checks that read several keys at once."""
-    if scenario.controller in ("zigzag", "boustrophedon") and scenario.has_terrain:
+    if scenario.controller in WITHOUT_WALLS and scenario.has_terrain:
         raise ScenarioError(
             f"scenario key 'controller': '{scenario.controller}' flies the open domain's lanes and knows no walls or robot "
             "bodies; with map, obstacles or robot_radius use one of paper, paper-literal, paper-eq16"

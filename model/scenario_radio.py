@@ -36,10 +36,10 @@ def resolve_radio_key(key: str, value: Any) -> Any:
 
 def check_radio(scenario: Any) -> None:
     """The checks that need the whole scenario; raises RadioKeyError."""
-    if scenario.planning == "local" and scenario.controller in ("zigzag", "boustrophedon"):
+    if scenario.planning == "local" and scenario.controller in ("zigzag", "boustrophedon", "anicov"):
         raise RadioKeyError(
             f"scenario key 'planning': 'local' runs Algorithms 1-2 on each robot; controller "
-            f"'{scenario.controller}' flies fixed lanes and plans nothing: use planning = \"central\""
+            f"'{scenario.controller}' flies lanes planned for the whole team at once: use planning = \"central\""
         )
     if scenario.planning == "local" and scenario.objectives:
         raise RadioKeyError(

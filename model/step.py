@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from model.clearance import disk_is_free, step_or_stay
-from model.control import combined_law, global_law, local_law
+from model.control import combined_law, global_law, local_law, pursuit_law
 from model.dynamics import unicycle_step
 from model.ground import Ground
 from model.occlusion import teammates_in_view
@@ -34,6 +34,7 @@ class LawParameters(NamedTuple):
     target_ticks: int  # Λ* in fixed-point ticks
     literal_heading: bool  # eq. 11 as printed
     literal_omega: bool  # eq. 16 as printed
+    pursuit: bool = False  # the anicov controller: pure pursuit of a carrot (model.control.pursuit_law)
 
 
 @njit(cache=True)
@@ -85,6 +86,9 @@ def decide_and_sense(
     shortest free path when a wall hides it), ``positions`` (N, 2) every robot's position with this
     one's at row ``me`` (teammates hide cells); in the open world neither is read."""
     e_omega, w_left, w_right, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, positions, me)
+    if law.pursuit:
+        v, omega = pursuit_law(x, y, theta, objective_x, objective_y, law.k_v, law.k_omega, law.dt)
+        return v, omega, e_omega, row0, col0, ticks
     u_loc, theta_loc = local_law(e_omega, w_left, w_right, theta, law.half_angle)
     u_glo, theta_glo = global_law(x, y, objective_x, objective_y, law.sensing_range, law.literal_heading)
     if ground.walls:

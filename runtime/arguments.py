@@ -10,12 +10,12 @@ from __future__ import annotations
 import argparse
 
 from model.parameters import starting_poses
-from model.scenario import CONTROLLERS, PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
+from model.scenario import CONTROLLER_CHOICES, PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
 
 CLOCKS = ("lockstep", "realtime")
 
 
-def add_scenario_arguments(parser: argparse.ArgumentParser, controllers: tuple[str, ...] = CONTROLLERS) -> None:
+def add_scenario_arguments(parser: argparse.ArgumentParser, controllers: tuple[str, ...] = CONTROLLER_CHOICES) -> None:
     """--config, --n, --seed, --controller: which scenario, with overrides of its keys."""
     parser.add_argument("--config", help="scenario TOML (default: scenarios/paper.toml)")
     parser.add_argument("--n", type=int, help="team size (overrides the scenario's 'agents'; the paper's is 4)")
@@ -25,7 +25,7 @@ def add_scenario_arguments(parser: argparse.ArgumentParser, controllers: tuple[s
 
 def add_team_arguments(parser: argparse.ArgumentParser) -> None:
     """The scenario arguments of a team on the bus (no zig-zag there), and its clock."""
-    add_scenario_arguments(parser, tuple(c for c in CONTROLLERS if c not in ("zigzag", "boustrophedon")))
+    add_scenario_arguments(parser, tuple(c for c in CONTROLLER_CHOICES if c not in ("zigzag", "boustrophedon")))
     parser.add_argument(
         "--clock",
         choices=CLOCKS,

@@ -63,7 +63,10 @@ def test_the_paper_summary_has_no_radio_keys(small):
         ({"comm_range": 0.0}, "scenario key 'comm_range': expected a positive number or inf"),
         ({"comm_range": "far"}, "scenario key 'comm_range'"),
         ({"planning": "everywhere"}, "scenario key 'planning': expected one of central, local"),
-        ({"planning": "local", "controller": "zigzag"}, "controller 'zigzag' flies fixed lanes"),
+        (
+            {"planning": "local", "controller": "zigzag"},
+            "controller 'zigzag' flies lanes planned for the whole team at once",
+        ),
         ({"robot_radius": 0.5, "comm_range": 2.0}, "scenario key 'comm_range': expected at least safety_range"),
     ],
 )

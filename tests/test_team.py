@@ -56,6 +56,20 @@ def test_lockstep_over_zenoh_equals_in_process_engine_byte_for_byte(tmp_path, ag
     assert (bandwidth["bytes_out_per_step"] < 100) == (deltas == "event")
 
 
+def test_the_anicov_controller_over_zenoh_equals_the_engine_with_the_same_messages(tmp_path):
+    """controller = "best" (the anicov controller): the coordinator plans the spiral's carrots, each agent
+    pursues its own; lockstep over Zenoh is anicov run byte for byte."""
+    config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=3, seed=5, controller="best")
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+    assert engine.returncode == 0, engine.stderr
+    team = unique_team()
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record", team=team))
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "coverage        complete" in launched.stdout
+    assert json.loads((tmp_path / "team" / "summary.json").read_text())["scenario"]["controller"] == "anicov"
+    assert_same_run(tmp_path / "engine", tmp_path / "team")
+
+
 def test_thirty_agent_processes_equal_the_engine(tmp_path):
     config = write_scenario(tmp_path / "s.toml", domain=[50.0, 50.0], agents=30, seed=1)
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet")

@@ -1,0 +1,282 @@
+"""The ``anicov`` controller's planner: a spiral at the sensor's best spacing, then passes over what is left.
+
+Beyond the paper (docs/controller.md, with the measurements: it beats the paper's law and the
+boustrophedon team at N = 1 only, so far). What the runs of the paper's law show: a robot stands R/2
+from a blob's centroid and stares at it (eq. 10), and a camera whose ability α (eq. 2) is five times Λ*
+at its apex wastes most of what it senses while standing; a straight pass at full speed wastes least.
+So:
+
+1. **A spiral.** A rectangular spiral inward, its rings :func:`best_lane_spacing` apart (from eq. 2:
+   the widest spacing at which two neighbouring passes at k_v still bring the point midway to Λ*), the
+   outer ring d100 inside the edges. Lanes back and forth need a run-up of about R outside the domain
+   at every lane's start (a point beside a lane is seen only from behind it); a spiral needs one. The
+   spiral is cut into N pieces of equal length; each robot is given a piece, and the end to start
+   from, by the least total transit (scipy's ``linear_sum_assignment``), entered :func:`lead_in` before
+   its first point.
+2. **Passes.** A robot done with its piece takes the uncovered blobs in turns (cells with Υ > 0 within
+   a lane spacing of each other, leaving out the strips robots still on their piece will sweep): the
+   assignment of free robots to blobs minimises their total distance (``linear_sum_assignment``), and
+   a pass runs along the blob's major axis through its centroid, entered :func:`lead_in` before it.
+
+The planner speaks the paper's messages: every CARROT_PERIOD (model.scenario) it gives each robot one
+objective, a point :data:`LOOKAHEAD` ahead of it along its path (pure pursuit's carrot); the robot
+drives toward it with :func:`model.control.pursuit_law`. Same interface as
+:class:`model.planning.Planner`, so the engine and the coordinator run either.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+from scipy.optimize import linear_sum_assignment, minimize_scalar
+
+from model.metrics import coverage_distance, straight_pass_coverage
+from model.objectives import BlobObjectives
+from model.scenario import CARROT_PERIOD, Scenario
+
+Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
+
+LOOKAHEAD = 2.0
+"""Distance ahead along the path at which the carrot is put (units)."""
+
+
+def best_lane_spacing(scenario: Scenario) -> float:
+    """The lane spacing s that covers most area per unit time, from eq. 2 (Fig. 7's straight pass).
+
+    Two neighbouring passes at speed v bring the point midway between them Λ = 2 C(s/2) / v, C the
+    one-pass coverage at speed 1 (:func:`model.metrics.straight_pass_coverage`; the midpoint is the
+    least covered point between them, C being convex). The fastest speed that still reaches Λ* is
+    v(s) = min(k_v, 2 C(s/2) / Λ*), and the area swept per unit time s·v(s) is largest at the returned s.
+    """
+
+    def rate(spacing: float) -> float:
+        midway = straight_pass_coverage(spacing / 2.0, scenario.range, scenario.half_angle, scenario.alpha_max)
+        return -spacing * min(scenario.k_v, 2.0 * midway / scenario.lambda_star)
+
+    reach = 2.0 * scenario.range * math.sin(scenario.half_angle)
+    found = minimize_scalar(rate, bounds=(1e-3 * reach, reach), method="bounded", options={"xatol": 1e-6})
+    return float(found.x)
+
+
+def lead_in(scenario: Scenario, spacing: float) -> float:
+    """How far before a lane's first point the robot enters it: a point half a spacing beside the lane
+    comes into the wedge (half angle F) only once the robot is (s/2)/tan F behind it."""
+    return min(scenario.range, spacing / 2.0 / math.tan(scenario.half_angle))
+
+
+@dataclass
+class Route:
+    """A robot's polyline and how far along it (arc length) the robot has come."""
+
+    points: np.ndarray  # (K, 2)
+    along: np.ndarray  # (K,) cumulative arc length
+    progress: float = 0.0
+    cleanup: bool = False  # a pass over a blob (True) or the robot's piece of the lanes
+
+    @classmethod
+    def of(cls, points: np.ndarray, cleanup: bool = False) -> Route:
+        points = np.asarray(points, dtype=np.float64)
+        keep = np.concatenate([[True], np.linalg.norm(np.diff(points, axis=0), axis=1) > 1e-9])
+        points = points[keep]
+        along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+        return cls(points, along, 0.0, cleanup)
+
+    @property
+    def length(self) -> float:
+        return float(self.along[-1])
+
+    def point_at(self, distance: float) -> np.ndarray:
+        if len(self.points) == 1:
+            return self.points[0].copy()
+        distance = min(max(distance, 0.0), self.length)
+        segment = min(int(np.searchsorted(self.along, distance, side="right")) - 1, len(self.points) - 2)
+        span = max(self.along[segment + 1] - self.along[segment], 1e-300)
+        share = (distance - self.along[segment]) / span
+        return self.points[segment] + share * (self.points[segment + 1] - self.points[segment])
+
+    def advance(self, position: np.ndarray, window: float) -> None:
+        """Progress := the farthest point within ``window`` ahead whose distance to ``position`` is least
+        (a projection on the path near where the robot was, so a neighbouring lane is never taken)."""
+        best, best_distance = self.progress, math.inf
+        for k in range(len(self.points) - 1):
+            start, end = self.along[k], self.along[k + 1]
+            if end < self.progress or start > self.progress + window:
+                continue
+            a, b = self.points[k], self.points[k + 1]
+            d = b - a
+            span2 = float(d @ d)
+            t = 0.0 if span2 == 0.0 else float(np.clip((position - a) @ d / span2, 0.0, 1.0))
+            at = min(max(start + t * (end - start), self.progress), self.progress + window)
+            gap = float(np.linalg.norm(self.point_at(at) - position))
+            if gap <= best_distance:
+                best, best_distance = at, gap
+        self.progress = max(self.progress, best)
+
+    def done(self) -> bool:
+        return self.progress >= self.length - 1e-6
+
+
+def spiral_path(scenario: Scenario, spacing: float) -> np.ndarray:
+    """The one-robot sweep: a rectangular spiral inward, its outer ring d100 inside the domain's edges
+    and each ring ``spacing`` inside the one before (corners included), as a polyline (K, 2)."""
+    width, height = scenario.domain
+    d100 = coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
+    first = min(d100, width / 2.0, height / 2.0)
+    left, bottom, right, top = first, first, width - first, height - first
+    points = [(left, bottom)]
+    while right - left > 1e-9 and top - bottom > 1e-9:
+        points += [(right, bottom), (right, top), (left, top), (left, min(bottom + spacing, top))]
+        left, bottom, right, top = left + spacing, bottom + spacing, right - spacing, top - spacing
+        if right - left <= 1e-9 or top - bottom <= 1e-9:
+            break
+        points.append((left, bottom))
+    if len(points) == 1:  # a domain thinner than two rings: one pass along it
+        points.append((right, top))
+    return np.array(points, dtype=np.float64)
+
+
+def spiral_pieces(scenario: Scenario, spacing: float) -> list[np.ndarray]:
+    """The spiral cut into N pieces of equal length (polylines), one per robot."""
+    whole = Route.of(spiral_path(scenario, spacing))
+    cuts = np.linspace(0.0, whole.length, scenario.agents + 1)
+    pieces = []
+    for low, high in itertools.pairwise(cuts):
+        inner = whole.points[(whole.along > low) & (whole.along < high)]
+        pieces.append(np.vstack([whole.point_at(low), inner, whole.point_at(high)]))
+    return pieces
+
+
+def with_run_up(piece: np.ndarray, lead: float) -> np.ndarray:
+    """A piece entered ``lead`` before its first point, along its first stretch (the camera looks ahead)."""
+    direction = piece[1] - piece[0]
+    direction = direction / max(float(np.linalg.norm(direction)), 1e-300)
+    return np.vstack([piece[0] - lead * direction, piece])
+
+
+def assign_pieces(pieces: list[np.ndarray], positions: np.ndarray, lead: float) -> list[np.ndarray]:
+    """Each robot's route (its start, then its piece from the nearer end, with a run-up): the assignment
+    of robots to pieces and ends with the least total transit (linear_sum_assignment)."""
+    forward = [with_run_up(piece, lead) for piece in pieces]
+    backward = [with_run_up(piece[::-1], lead) for piece in pieces]
+    to_forward = np.array([[np.linalg.norm(route[0] - p) for route in forward] for p in positions])
+    to_backward = np.array([[np.linalg.norm(route[0] - p) for route in backward] for p in positions])
+    robots, chosen = linear_sum_assignment(np.minimum(to_forward, to_backward))
+    routes: list[np.ndarray] = [np.zeros((0, 2))] * len(positions)
+    for robot, piece in zip(robots, chosen, strict=True):
+        route = forward[piece] if to_forward[robot, piece] <= to_backward[robot, piece] else backward[piece]
+        routes[robot] = np.vstack([positions[robot][None, :], route])
+    return routes
+
+
+def blob_passes(
+    lack: np.ndarray, cell: float, lead: float, spacing: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every uncovered blob as a pass along its major axis through its centroid: (M, 2, 2, 2) the two
+    ways to fly it, each (entry ``lead`` before the blob, exit at its far end); (M, 2) the centroids;
+    the blob labels of the grid. A blob: the cells with Υ > 0 that lie closer than a lane spacing to
+    each other (8-connected once grown by half a spacing), so that the scraps a row of lanes leaves
+    along an edge make one pass along it, not one each."""
+    uncovered = (lack > 0.0).astype(np.uint8)
+    reach = max(1, round(spacing / 2.0 / cell))
+    grown = cv2.dilate(uncovered, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1, 2 * reach + 1)))
+    count, labels = cv2.connectedComponents(grown, connectivity=8)
+    labels = labels * uncovered
+    ways, centres = [], []
+    for k in range(1, count):
+        rows, cols = np.nonzero(labels == k)
+        if len(rows) == 0:
+            continue
+        points = np.stack([(cols + 0.5) * cell, (rows + 0.5) * cell], axis=1)
+        centre = points.mean(axis=0)
+        spread = points - centre
+        axis = np.linalg.eigh(spread.T @ spread)[1][:, -1] if len(points) > 1 else np.array([1.0, 0.0])
+        extent = spread @ axis
+        low, high = centre + extent.min() * axis, centre + extent.max() * axis
+        ways.append([[low - lead * axis, high], [high + lead * axis, low]])
+        centres.append(centre)
+    return np.array(ways).reshape(-1, 2, 2, 2), np.array(centres).reshape(-1, 2), labels
+
+
+@dataclass
+class LanePlanner:
+    """The ``anicov`` controller's planning (see the module): one carrot per robot per call."""
+
+    scenario: Scenario
+    blobs: BlobObjectives = field(default_factory=BlobObjectives)
+    routes: dict[int, Route] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.spacing = best_lane_spacing(self.scenario)
+        self.lead = lead_in(self.scenario, self.spacing)
+
+    def plan(self, lack: np.ndarray, positions: np.ndarray, members: list[int] | None = None) -> np.ndarray:
+        """A carrot (x, y) for every member (default all, in id order), shape (M, 2)."""
+        ids = list(range(len(positions))) if members is None else list(members)
+        positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
+        if not self.routes:
+            pieces = spiral_pieces(self.scenario, self.spacing)
+            for agent, route in zip(
+                range(self.scenario.agents), assign_pieces(pieces, self._all(ids, positions), self.lead), strict=True
+            ):
+                self.routes[agent] = Route.of(route)
+        window = 4.0 * self.scenario.k_v * CARROT_PERIOD + LOOKAHEAD
+        free = []
+        for index, agent in enumerate(ids):
+            route = self.routes[agent]
+            route.advance(positions[index], window)
+            if route.done():
+                free.append(index)
+        if free:
+            self._give_passes(lack, positions, ids, free)
+        targets = np.array(
+            [self.routes[agent].point_at(self.routes[agent].progress + LOOKAHEAD) for agent in ids], dtype=np.float64
+        )
+        return targets.reshape(-1, 2)
+
+    def _all(self, ids: list[int], positions: np.ndarray) -> np.ndarray:
+        """Every robot's position at the first plan (a robot not among the members: the domain's centre)."""
+        where = np.tile(np.array(self.scenario.domain) / 2.0, (self.scenario.agents, 1))
+        for index, agent in enumerate(ids):
+            where[agent] = positions[index]
+        return where
+
+    def _give_passes(self, lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]) -> None:
+        """Robots done with their route take a pass each over the uncovered blobs, by least total
+        distance to the passes' entries; a robot left without one stays where it is."""
+        ways, centres, labels = blob_passes(self._unclaimed(lack, ids), self.scenario.cell, self.lead, self.spacing)
+        self.blobs = BlobObjectives(centres, labels.astype(np.int32))
+        for index in free:  # stay, unless given a pass below
+            self.routes[ids[index]] = Route.of(positions[index][None, :], cleanup=True)
+        if not len(ways):
+            return
+        distance = np.linalg.norm(positions[free][:, None, None, :] - ways[None, :, :, 0, :], axis=3)  # (F, M, 2)
+        robots, chosen = linear_sum_assignment(distance.min(axis=2))
+        for robot, blob in zip(robots, chosen, strict=True):
+            index = free[robot]
+            entry, exit_ = ways[blob, int(np.argmin(distance[robot, blob]))]
+            self.routes[ids[index]] = Route.of(np.array([positions[index], entry, exit_]), cleanup=True)
+
+    def _unclaimed(self, lack: np.ndarray, ids: list[int]) -> np.ndarray:
+        """Υ without the strips that robots still on their route will sweep (half a spacing each side of
+        what is left of it), so that a robot done early does not fly another's lanes before it."""
+        claimed = np.zeros(lack.shape, dtype=np.uint8)
+        cell = self.scenario.cell
+        width = max(1, round(self.spacing / cell))
+        for agent in ids:
+            route = self.routes[agent]
+            if route.cleanup or route.done():
+                continue
+            ahead = route.points[route.along > route.progress]
+            line = np.vstack([route.point_at(route.progress), ahead]) / cell
+            cv2.polylines(claimed, [np.round(line).astype(np.int32)], False, 1, thickness=width)
+        return np.where(claimed.astype(bool), 0.0, lack)
+
+    def labels(self) -> np.ndarray | None:
+        return None if self.blobs.labels is None else self.blobs.labels.astype(np.uint16)
+
+    def record(self, step: int, targets: np.ndarray) -> Plan:
+        return (step, tuple(range(len(targets))), targets.copy(), self.blobs.positions.copy(), self.labels())
