@@ -1,22 +1,24 @@
 """The ``anicov`` controller's planner: a spiral at the sensor's best spacing, then passes over what is left.
 
-Beyond the paper (docs/controller.md, with the measurements: it beats the paper's law and the
-boustrophedon team at N = 1 only, so far). What the runs of the paper's law show: a robot stands R/2
-from a blob's centroid and stares at it (eq. 10), and a camera whose ability α (eq. 2) is five times Λ*
-at its apex wastes most of what it senses while standing; a straight pass at full speed wastes least.
-So:
+Beyond the paper (docs/controller.md has the measurements and the reasons). What the runs of the
+paper's law show: a robot stands R/2 from a blob's centroid and stares at it (eq. 10), and a camera
+whose ability α (eq. 2) is five times Λ* at its apex wastes most of what it senses while standing; a
+straight pass at full speed wastes least. So:
 
-1. **A spiral.** A rectangular spiral inward, its rings :func:`best_lane_spacing` apart (from eq. 2:
-   the widest spacing at which two neighbouring passes at k_v still bring the point midway to Λ*), the
-   outer ring d100 inside the edges. Lanes back and forth need a run-up of about R outside the domain
-   at every lane's start (a point beside a lane is seen only from behind it); a spiral needs one. The
-   spiral is cut into N pieces of equal length; each robot is given a piece, and the end to start
-   from, by the least total transit (scipy's ``linear_sum_assignment``), entered :func:`lead_in` before
-   its first point.
-2. **Passes.** A robot done with its piece takes the uncovered blobs in turns (cells with Υ > 0 within
+1. **A spiral.** A rectangular spiral inward (:func:`spiral_path`), its rings evenly spaced at most
+   :func:`best_lane_spacing` apart (from eq. 2: the widest spacing at which two neighbouring passes at
+   k_v still bring the point midway to Λ*), the outer ring d100 inside the edges, the innermost d100
+   from the centre line. Lanes back and forth need a run-up of about R outside the domain at every
+   lane's start (a forward camera sees a point beside a lane only from behind it); a spiral needs one.
+2. **Pieces.** The spiral is cut into N pieces, flown inward (flown outward, a ring's corners leave
+   gaps no later ring closes), each entered :func:`lead_in` before its first point. Robots take pieces
+   by the assignment that minimises the longest transit, then the total (:func:`bottleneck_assignment`
+   on scipy's ``linear_sum_assignment``), and the pieces are resized until transit, run-up and flight
+   take every robot about as long (:func:`balanced_routes`): the team finishes with its slowest robot.
+3. **Passes.** A robot done with its piece takes the uncovered blobs in turns (cells with Υ > 0 within
    a lane spacing of each other, leaving out the strips robots still on their piece will sweep): the
-   assignment of free robots to blobs minimises their total distance (``linear_sum_assignment``), and
-   a pass runs along the blob's major axis through its centroid, entered :func:`lead_in` before it.
+   assignment of free robots to blobs minimises their total distance, and a pass runs along the blob's
+   major axis through its centroid, entered :func:`lead_in` before it.
 
 The planner speaks the paper's messages: every CARROT_PERIOD (model.scenario) it gives each robot one
 objective, a point :data:`LOOKAHEAD` ahead of it along its path (pure pursuit's carrot); the robot
@@ -29,6 +31,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import cv2
 import numpy as np
@@ -42,6 +45,10 @@ Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
 
 LOOKAHEAD = 2.0
 """Distance ahead along the path at which the carrot is put (units)."""
+BALANCING_ROUNDS = 10
+"""Rounds of resizing the pieces so that every robot finishes together (balanced_routes)."""
+MIN_PIECE = 0.2
+"""No piece shorter than this share of an equal one (a robot far from everything still flies some)."""
 
 
 def best_lane_spacing(scenario: Scenario) -> float:
@@ -121,33 +128,65 @@ class Route:
 
 
 def spiral_path(scenario: Scenario, spacing: float) -> np.ndarray:
-    """The one-robot sweep: a rectangular spiral inward, its outer ring d100 inside the domain's edges
-    and each ring ``spacing`` inside the one before (corners included), as a polyline (K, 2)."""
+    """The one-robot sweep: a rectangular spiral inward, as a polyline (K, 2). Its outer ring lies d100
+    inside the domain's edges; its rings are evenly spaced, at most ``spacing`` apart, so that the
+    innermost one is at most d100 from the domain's centre line (one pass brings Λ* that far): a
+    spiral whose last ring stopped short would leave its centre to slow passes after it."""
     width, height = scenario.domain
     d100 = coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
     first = min(d100, width / 2.0, height / 2.0)
-    left, bottom, right, top = first, first, width - first, height - first
-    points = [(left, bottom)]
-    while right - left > 1e-9 and top - bottom > 1e-9:
-        points += [(right, bottom), (right, top), (left, top), (left, min(bottom + spacing, top))]
-        left, bottom, right, top = left + spacing, bottom + spacing, right - spacing, top - spacing
-        if right - left <= 1e-9 or top - bottom <= 1e-9:
-            break
-        points.append((left, bottom))
-    if len(points) == 1:  # a domain thinner than two rings: one pass along it
-        points.append((right, top))
+    inward = min(width, height) / 2.0 - 2.0 * first  # from the outer ring to where the innermost may be
+    rings = max(0, math.ceil(inward / spacing - 1e-9))
+    step = inward / rings if rings else 0.0
+    points: list[tuple[float, float]] = []
+    for ring in range(rings + 1):
+        left, bottom = first + ring * step, first + ring * step
+        right, top = width - left, height - bottom
+        if ring < rings:
+            points += [(left, bottom), (right, bottom), (right, top), (left, top), (left, bottom + step)]
+        elif top - bottom > 1e-9 and right - left > 1e-9:
+            points += [(left, bottom), (right, bottom), (right, top), (left, top), (left, bottom)]
+        else:  # the innermost ring is a line along the longer side
+            points += [(left, bottom), (right, top)]
     return np.array(points, dtype=np.float64)
 
 
-def spiral_pieces(scenario: Scenario, spacing: float) -> list[np.ndarray]:
-    """The spiral cut into N pieces of equal length (polylines), one per robot."""
+def spiral_pieces(scenario: Scenario, spacing: float, cuts: np.ndarray | None = None) -> list[np.ndarray]:
+    """The spiral cut into N pieces (polylines), one per robot: of equal length, or at ``cuts`` (N + 1
+    arc lengths from 0 to the spiral's length)."""
     whole = Route.of(spiral_path(scenario, spacing))
-    cuts = np.linspace(0.0, whole.length, scenario.agents + 1)
+    if cuts is None:
+        cuts = np.linspace(0.0, whole.length, scenario.agents + 1)
     pieces = []
     for low, high in itertools.pairwise(cuts):
         inner = whole.points[(whole.along > low) & (whole.along < high)]
         pieces.append(np.vstack([whole.point_at(low), inner, whole.point_at(high)]))
     return pieces
+
+
+def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, lead: float) -> list[np.ndarray]:
+    """Each robot's route, its piece sized so that the team finishes together. From equal pieces, each
+    round assigns robots to pieces (:func:`assign_pieces`), then moves every piece's length halfway to
+    the one that makes transit, run-up and flight the same for all; the routes with the earliest
+    estimated finish (longest transit + run-up + piece) are kept."""
+    total = Route.of(spiral_path(scenario, spacing)).length
+    lengths = np.full(scenario.agents, total / scenario.agents)
+    best, best_finish = None, math.inf
+    for _ in range(BALANCING_ROUNDS + 1):
+        cuts = np.concatenate([[0.0], np.cumsum(lengths)])
+        cuts[-1] = total
+        pieces = spiral_pieces(scenario, spacing, cuts)
+        routes, owners = assign_pieces(pieces, positions, lead, with_owners=True)
+        transit = np.array(
+            [np.linalg.norm(routes[owners[k]][1] - positions[owners[k]]) + lead for k in range(len(pieces))]
+        )
+        finish = float(np.max(transit + lengths))
+        if finish < best_finish:
+            best, best_finish = routes, finish
+        target = np.maximum((total + transit.sum()) / scenario.agents - transit, MIN_PIECE * total / scenario.agents)
+        lengths = 0.5 * lengths + 0.5 * target / target.sum() * total
+    assert best is not None
+    return best
 
 
 def with_run_up(piece: np.ndarray, lead: float) -> np.ndarray:
@@ -157,19 +196,38 @@ def with_run_up(piece: np.ndarray, lead: float) -> np.ndarray:
     return np.vstack([piece[0] - lead * direction, piece])
 
 
-def assign_pieces(pieces: list[np.ndarray], positions: np.ndarray, lead: float) -> list[np.ndarray]:
-    """Each robot's route (its start, then its piece from the nearer end, with a run-up): the assignment
-    of robots to pieces and ends with the least total transit (linear_sum_assignment)."""
-    forward = [with_run_up(piece, lead) for piece in pieces]
-    backward = [with_run_up(piece[::-1], lead) for piece in pieces]
-    to_forward = np.array([[np.linalg.norm(route[0] - p) for route in forward] for p in positions])
-    to_backward = np.array([[np.linalg.norm(route[0] - p) for route in backward] for p in positions])
-    robots, chosen = linear_sum_assignment(np.minimum(to_forward, to_backward))
+def bottleneck_assignment(cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows to columns (square ``cost``) minimising the largest cost taken, then the total among those
+    (the team finishes when its slowest robot does): the least threshold that still admits a perfect
+    matching, found by bisection over the costs, then linear_sum_assignment within it."""
+    values = np.unique(cost)
+    low, high = 0, len(values) - 1
+    while low < high:
+        middle = (low + high) // 2
+        allowed = (cost <= values[middle]).astype(np.float64)
+        rows, cols = linear_sum_assignment(-allowed)
+        if allowed[rows, cols].sum() == len(cost):
+            high = middle
+        else:
+            low = middle + 1
+    capped = np.where(cost <= values[low], cost, cost.max() * len(cost) + 1.0)
+    return linear_sum_assignment(capped)
+
+
+def assign_pieces(pieces: list[np.ndarray], positions: np.ndarray, lead: float, with_owners: bool = False) -> Any:
+    """Each robot's route: its start, then its piece entered ``lead`` before the piece's first point.
+    Pieces are flown the way the spiral goes (inward: flown outward, a ring's corners leave gaps the
+    next ring does not close); the assignment minimises the longest transit, then the total.
+    ``with_owners``: also each piece's robot."""
+    entries = [with_run_up(piece, lead) for piece in pieces]
+    transit = np.array([[np.linalg.norm(route[0] - p) for route in entries] for p in positions])
+    robots, chosen = bottleneck_assignment(transit)
     routes: list[np.ndarray] = [np.zeros((0, 2))] * len(positions)
+    owners = [0] * len(pieces)
     for robot, piece in zip(robots, chosen, strict=True):
-        route = forward[piece] if to_forward[robot, piece] <= to_backward[robot, piece] else backward[piece]
-        routes[robot] = np.vstack([positions[robot][None, :], route])
-    return routes
+        routes[robot] = np.vstack([positions[robot][None, :], entries[piece]])
+        owners[piece] = int(robot)
+    return (routes, owners) if with_owners else routes
 
 
 def blob_passes(
@@ -218,10 +276,8 @@ class LanePlanner:
         ids = list(range(len(positions))) if members is None else list(members)
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
         if not self.routes:
-            pieces = spiral_pieces(self.scenario, self.spacing)
-            for agent, route in zip(
-                range(self.scenario.agents), assign_pieces(pieces, self._all(ids, positions), self.lead), strict=True
-            ):
+            routes = balanced_routes(self.scenario, self.spacing, self._all(ids, positions), self.lead)
+            for agent, route in zip(range(self.scenario.agents), routes, strict=True):
                 self.routes[agent] = Route.of(route)
         window = 4.0 * self.scenario.k_v * CARROT_PERIOD + LOOKAHEAD
         free = []

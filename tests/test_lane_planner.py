@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.optimize import linear_sum_assignment
 
 from model.control import pursuit_law
 from model.lane_planner import (
@@ -15,8 +16,10 @@ from model.lane_planner import (
     LanePlanner,
     Route,
     assign_pieces,
+    balanced_routes,
     best_lane_spacing,
     blob_passes,
+    bottleneck_assignment,
     lead_in,
     spiral_path,
     spiral_pieces,
@@ -37,30 +40,58 @@ def test_the_best_spacing_is_where_two_full_speed_passes_just_bring_the_midpoint
     assert best_lane_spacing(PAPER.with_overrides(lambda_star=200.0)) < spacing
 
 
-def test_the_spiral_stays_inside_its_rings_apart_and_its_pieces_share_it_equally():
+def test_the_spiral_stays_inside_its_rings_at_most_a_spacing_apart_down_to_the_centre():
     spacing = best_lane_spacing(PAPER)
     path = spiral_path(PAPER, spacing)
     d100 = coverage_distance(PAPER.lambda_star, PAPER.range, PAPER.half_angle, PAPER.alpha_max)
     assert path.min() >= d100 - 1e-9 and path.max() <= 100.0 - d100 + 1e-9
-    assert np.allclose(path[1], (100.0 - d100, d100))  # the outer ring first, along the bottom edge
+    assert np.allclose(path[:2], [(d100, d100), (100.0 - d100, d100)])  # the outer ring first, d100 in
     steps = np.diff(path, axis=0)
     assert np.all((np.abs(steps[:, 0]) < 1e-9) | (np.abs(steps[:, 1]) < 1e-9))  # axis-aligned runs only
-    whole = Route.of(path).length
-    for agents in (1, 4, 7):
-        pieces = spiral_pieces(PAPER.with_overrides(agents=agents), spacing)
-        lengths = [Route.of(piece).length for piece in pieces]
-        assert len(pieces) == agents and lengths == pytest.approx([whole / agents] * agents)
+    lows = sorted({round(x, 9) for x, y in path if abs(x - y) < 1e-9 and x < 50.0})  # each ring's corner
+    assert max(np.diff(lows)) <= spacing + 1e-9
+    assert 50.0 - lows[-1] <= d100 + 1e-9  # the innermost ring within one pass's full coverage of the centre
+    wide = spiral_path(PAPER.with_overrides(domain=[200.0, 50.0]), spacing)
+    assert wide[:, 0].max() > 190.0 and wide[:, 1].max() < 50.0
 
 
-def test_each_robot_gets_one_piece_from_its_nearer_end_with_a_run_up():
+def test_the_pieces_cover_the_spiral_and_each_robot_flies_one_inward_after_a_run_up():
     scenario = PAPER.with_overrides(agents=3)
-    pieces = spiral_pieces(scenario, best_lane_spacing(scenario))
+    spacing = best_lane_spacing(scenario)
+    whole = Route.of(spiral_path(scenario, spacing)).length
+    pieces = spiral_pieces(scenario, spacing)
+    assert [Route.of(piece).length for piece in pieces] == pytest.approx([whole / 3] * 3)
     starts = np.array([pieces[2][0] + [1.0, 0.0], pieces[0][-1] + [0.0, 1.0], pieces[1][0]])
     routes = assign_pieces(pieces, starts, lead=5.0)
-    assert np.allclose(routes[0][0], starts[0]) and np.allclose(routes[0][-1], pieces[2][-1])  # forward
-    assert np.allclose(routes[1][-1], pieces[0][0])  # flown backward, from the end it started by
-    run_up = routes[2][2] - routes[2][1]  # the entry point, 5 before the piece's first point along it
-    assert np.linalg.norm(run_up) == pytest.approx(5.0) and np.allclose(routes[2][2], pieces[1][0])
+    assert all(np.allclose(route[0], start) for route, start in zip(routes, starts, strict=True))
+    for route in routes:  # its piece, flown as the spiral goes, entered 5 before its first point
+        piece = next(piece for piece in pieces if np.allclose(route[-1], piece[-1]))
+        assert np.allclose(route[2:], piece) and np.linalg.norm(route[2] - route[1]) == pytest.approx(5.0)
+    assert sorted(np.allclose(route[-1], piece[-1]) for route in routes for piece in pieces).count(True) == 3
+
+
+def test_the_bottleneck_assignment_minimises_the_longest_cost_where_the_least_total_would_not():
+    cost = np.array([[0.0, 5.0], [5.0, 9.0]])  # least total: 0 + 9 (longest 9); least longest: 5 + 5
+    rows, cols = bottleneck_assignment(cost)
+    assert cost[rows, cols].max() == 5.0
+    big = np.random.default_rng(3).uniform(0, 100, (12, 12))
+    rows, cols = bottleneck_assignment(big)
+    assert sorted(cols) == list(range(12))
+    best_total_rows, best_total_cols = linear_sum_assignment(big)
+    assert big[rows, cols].max() <= big[best_total_rows, best_total_cols].max()
+
+
+def test_balanced_pieces_make_every_robot_finish_closer_together_than_equal_ones():
+    scenario = PAPER.with_overrides(agents=6, seed=2)
+    spacing, lead = best_lane_spacing(scenario), 7.6
+    positions = np.random.default_rng(2).uniform(0, 100, (6, 2))
+
+    def finishes(routes):
+        return [Route.of(route).length for route in routes]  # transit + run-up + piece: time at k_v
+
+    equal = finishes(assign_pieces(spiral_pieces(scenario, spacing), positions, lead))
+    balanced = finishes(balanced_routes(scenario, spacing, positions, lead))
+    assert max(balanced) < max(equal)
 
 
 def test_progress_follows_the_robot_along_its_route_never_back_and_never_onto_the_next_ring():
