@@ -124,6 +124,16 @@ def command_sweep_plot(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def command_controller_table(args: argparse.Namespace) -> int:
+    from anicov.controller_table import controller_table
+
+    table = controller_table(Path(args.out))
+    if args.write:
+        Path(args.write).write_text(table)
+    print(table, end="")
+    return EXIT_OK
+
+
 def command_router(args: argparse.Namespace) -> int:
     import zenoh
 
@@ -244,6 +254,13 @@ def _add_sweep(commands: argparse._SubParsersAction) -> None:
     plot.add_argument("--by", help="one line per value of this key, e.g. controller")
     plot.add_argument("--png", help="where to write it (default OUT/<y>_by_<x>.png)")
     plot.set_defaults(handler=command_sweep_plot)
+
+    table = commands.add_parser(
+        "controller-table", help="issue 14's comparison of controllers from a sweep's table, goals checked"
+    )
+    table.add_argument("out", help="the sweep's output directory (sweeps/controllers.toml)")
+    table.add_argument("--write", help="also write the Markdown table to this file")
+    table.set_defaults(handler=command_controller_table)
 
 
 def _add_bus_tools(commands: argparse._SubParsersAction) -> None:

@@ -18,7 +18,7 @@ straight pass at full speed wastes least. So:
 3. **Passes.** A robot done with its piece takes the uncovered blobs in turns (cells with Υ > 0 within
    a lane spacing of each other, leaving out the strips robots still on their piece will sweep): the
    assignment of free robots to blobs minimises their total distance, and a pass runs along the blob's
-   major axis through its centroid, entered :func:`lead_in` before it.
+   major axis through its centroid, from its nearer end.
 
 The planner speaks the paper's messages: every CARROT_PERIOD (model.scenario) it gives each robot one
 objective, a point :data:`LOOKAHEAD` ahead of it along its path (pure pursuit's carrot); the robot
@@ -303,7 +303,9 @@ class LanePlanner:
     def _give_passes(self, lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]) -> None:
         """Robots done with their route take a pass each over the uncovered blobs, by least total
         distance to the passes' entries; a robot left without one stays where it is."""
-        ways, centres, labels = blob_passes(self._unclaimed(lack, ids), self.scenario.cell, self.lead, self.spacing)
+        # No run-up before a pass: measured, entering at the blob's near end finishes sooner (N = 10: 3.10
+        # t* against 3.29 with the piece's run-up; what the pass's start leaves, a later pass takes).
+        ways, centres, labels = blob_passes(self._unclaimed(lack, ids), self.scenario.cell, 0.0, self.spacing)
         self.blobs = BlobObjectives(centres, labels.astype(np.int32))
         for index in free:  # stay, unless given a pass below
             self.routes[ids[index]] = Route.of(positions[index][None, :], cleanup=True)

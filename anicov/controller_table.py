@@ -1,0 +1,71 @@
+"""Issue 14's comparison table, from a sweep of controllers and team sizes (``anicov controller-table DIR``).
+
+Reads DIR/runs.csv (``anicov sweep sweeps/controllers.toml --out DIR``) and writes a Markdown table: per
+team size, every controller's mean t_N/t*_N, its team path as a share of the one-robot zig-zag's (the
+``zigzag`` rows at N = 1 in the same table), how many runs completed, and, for the challenger
+(default ``anicov``), the issue's goals: below every other controller; t_N/t*_N ≤ 2.5 for N ≤ 10 and
+≤ 3.0 beyond; team path ≤ 55 % of the zig-zag's. Where a goal is missed the cell says by how much.
+"""
+
+from __future__ import annotations
+
+import csv
+from collections import defaultdict
+from pathlib import Path
+
+TIME_GOAL_SMALL, TIME_GOAL_LARGE, SMALL_TEAM = 2.5, 3.0, 10
+PATH_GOAL = 0.55
+ORDER = ("paper", "zigzag", "boustrophedon", "anicov")
+
+
+def read_runs(out_dir: Path) -> dict[tuple[int, str], list[dict[str, str]]]:
+    """The sweep's rows grouped by (team size, controller)."""
+    groups: dict[tuple[int, str], list[dict[str, str]]] = defaultdict(list)
+    with open(out_dir / "runs.csv", newline="") as file:
+        for row in csv.DictReader(file):
+            groups[(int(row["agents"]), row["controller"])].append(row)
+    return groups
+
+
+def _mean(values: list[float]) -> float:
+    return sum(values) / len(values) if values else float("nan")
+
+
+def controller_table(out_dir: Path, challenger: str = "anicov") -> str:
+    """The Markdown table (see the module)."""
+    groups = read_runs(out_dir)
+    controllers = [c for c in ORDER if any(key[1] == c for key in groups)]
+    controllers += sorted({key[1] for key in groups} - set(controllers))
+    one_robot = [float(row["team_path_length"]) for row in groups.get((1, "zigzag"), [])]
+    if not one_robot:
+        raise ValueError(f"{out_dir}/runs.csv: no zigzag run at N = 1, the path's yardstick")
+    yardstick = _mean(one_robot)
+    header = ["N", *(f"{c} t/t*" for c in controllers), *(f"{c} path" for c in controllers), "complete"]
+    if challenger in controllers:
+        header += [f"{challenger} vs best other", "time goal", "path goal"]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for agents in sorted({key[0] for key in groups}):
+        ratio, path, done, total = {}, {}, 0, 0
+        for controller in controllers:
+            rows = groups.get((agents, controller), [])
+            finished = [row for row in rows if row["completed"] == "True"]
+            ratio[controller] = _mean([float(row["time_ratio"]) for row in finished])
+            path[controller] = _mean([float(row["team_path_length"]) for row in rows]) / yardstick
+            done, total = done + len(finished), total + len(rows)
+        cells = [
+            str(agents),
+            *(f"{ratio[c]:.2f}" for c in controllers),
+            *(f"{100 * path[c]:.0f} %" for c in controllers),
+        ]
+        cells.append(f"{done}/{total}")
+        if challenger in controllers:
+            others = [ratio[c] for c in controllers if c != challenger]
+            best_other = min(others) if others else float("nan")
+            cells.append(f"{100 * (ratio[challenger] / best_other - 1):+.1f} %")
+            goal = TIME_GOAL_SMALL if agents <= SMALL_TEAM else TIME_GOAL_LARGE
+            over = ratio[challenger] - goal
+            cells.append("met" if over <= 0 else f"over by {over:.2f}")
+            over_path = path[challenger] - PATH_GOAL
+            cells.append("met" if over_path <= 0 else f"over by {100 * over_path:.0f} points")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
