@@ -82,6 +82,7 @@ def test_thirty_agent_processes_equal_the_engine(tmp_path):
     assert processes_of(team) == []
 
 
+@pytest.mark.slow  # a minute of wall clock: the paper's N = 4 run at speed 10 (realtime runs stay in the suite, smaller)
 def test_realtime_clock_completes_within_15_percent_of_lockstep(tmp_path):
     engine = anicov("run", "--n", "4", "--seed", "0", "--out", str(tmp_path / "l"), "--quiet")
     assert engine.returncode == 0, engine.stderr
@@ -97,21 +98,6 @@ def test_realtime_clock_completes_within_15_percent_of_lockstep(tmp_path):
     ratio = summary["completion_time"] / lockstep["completion_time"]
     (tmp_path / "ratio.txt").write_text(f"{ratio:.3f}\n")
     assert 0.85 <= ratio <= 1.15, ratio
-    # Bandwidth you can see: every process's reports reached the logger and its recording, and the
-    # launcher measured each robot's bytes per wall second.
-    rt = tmp_path / "rt"
-    reported = json.loads((rt / "logs" / "logger.counts.json").read_text())["bandwidth"]
-    assert set(reported) == {"agent-0", "agent-1", "agent-2", "agent-3", "coordinator-0", "logger-0"}
-    for agent in range(4):
-        counts = json.loads((rt / "logs" / f"agent-{agent}.counts.json").read_text())
-        # the logger's last report of a robot is at most what the robot counted at its exit
-        assert 0 < reported[f"agent-{agent}"]["bytes_out"] <= counts["bytes_sent"] + counts["bytes_served"]
-        assert 0 < reported[f"agent-{agent}"]["bytes_in"] <= counts["bytes_received"]
-    series = summarise_recording(rt / "recording.rrd", load_maps=False).traffic
-    assert {("agent-0", "bytes_out"), ("coordinator-0", "bytes_in")} <= set(series)
-    assert all(rate >= 0 for rates in series.values() for rate in rates) and max(series[("agent-0", "bytes_out")]) > 0
-    bandwidth = json.loads((rt / "bandwidth.json").read_text())
-    assert bandwidth["bytes_out_per_wall_second"] > 0 and "bus this run" in launched.stdout
 
 
 @pytest.mark.parametrize(("number", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"])

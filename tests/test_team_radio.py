@@ -64,7 +64,25 @@ def test_realtime_limited_range_with_local_planning_completes_and_ends_with_one_
     assert sum(count["relayed"] for count in counts) > 0  # and anti-entropy brought steps from teammates
     coordinator = json.loads((out / "coordinator_counts.json").read_text())
     assert {count["map_digest"] for count in counts} == {coordinator["map_digest"]}
+    assert_bandwidth_is_reported(out, launched.stdout, counts)
     assert processes_of(team) == []
+
+
+def assert_bandwidth_is_reported(out, stdout, counts):
+    """Bandwidth you can see: every process's reports reached the logger and its recording, and the
+    launcher measured each robot's bytes per wall second."""
+    reported = json.loads((out / "logs" / "logger.counts.json").read_text())["bandwidth"]
+    assert set(reported) == {"agent-0", "agent-1", "agent-2", "agent-3", "coordinator-0", "logger-0"}
+    for agent, count in enumerate(counts):
+        # the logger's last report of a robot is at most what the robot counted at its exit
+        assert 0 < reported[f"agent-{agent}"]["bytes_out"] <= count["bytes_sent"] + count["bytes_served"]
+        assert 0 < reported[f"agent-{agent}"]["bytes_in"] <= count["bytes_received"]
+    assert sum(count["bytes_served"] for count in counts) > 0  # anti-entropy answers count as traffic out
+    series = summarise_recording(out / "recording.rrd", load_maps=False).traffic
+    assert {("agent-0", "bytes_out"), ("coordinator-0", "bytes_in")} <= set(series)
+    assert all(rate >= 0 for rates in series.values() for rate in rates) and max(series[("agent-0", "bytes_out")]) > 0
+    bandwidth = json.loads((out / "bandwidth.json").read_text())
+    assert bandwidth["bytes_out_per_wall_second"] > 0 and "bus this run" in stdout
 
 
 def test_local_planning_finishes_the_run_after_the_coordinator_is_killed(tmp_path):
