@@ -78,7 +78,8 @@ def pursuit_law(
     """Beyond the paper, the ``anicov`` controller (docs/controller.md): drive at the objective, a carrot
     on the planned path (pure pursuit, Coulter 1992), at full speed until the carrot is within one step,
     with eq. 15-16's heading terms: v = k_v min(1, d/(k_v dt)) (1 − 2|e_θ|/π), ω = k_ω e_θ, e_θ the
-    wrapped heading error to the carrot, d its distance. |v| ≤ k_v and |ω| ≤ π k_ω, the paper's bounds."""
+    wrapped heading error to the carrot, d its distance. |v| ≤ k_v and |ω| ≤ π k_ω, the paper's bounds
+    (a carrot behind the robot makes it back up while it turns, as eq. 15 does)."""
     dx = objective_x - x
     dy = objective_y - y
     e_theta = wrap_angle(math.atan2(dy, dx) - theta)

@@ -18,7 +18,8 @@ straight pass at full speed wastes least. So:
 3. **Passes.** A robot done with its piece takes the uncovered blobs in turns (cells with Υ > 0 within
    a lane spacing of each other, leaving out the strips robots still on their piece will sweep): the
    assignment of free robots to blobs minimises their total distance, and a pass runs along the blob's
-   major axis through its centroid, from its nearer end.
+   major axis through its centroid, from its nearer end (or from before it, to make the pass at least
+   :func:`lead_in` long).
 
 The planner speaks the paper's messages: every CARROT_PERIOD (model.scenario) it gives each robot one
 objective, a point :data:`LOOKAHEAD` ahead of it along its path (pure pursuit's carrot); the robot
@@ -39,7 +40,7 @@ from scipy.optimize import linear_sum_assignment, minimize_scalar
 
 from model.metrics import coverage_distance, straight_pass_coverage
 from model.objectives import BlobObjectives
-from model.scenario import CARROT_PERIOD, Scenario
+from model.scenario import Scenario
 
 Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
 
@@ -106,20 +107,23 @@ class Route:
         return self.points[segment] + share * (self.points[segment + 1] - self.points[segment])
 
     def advance(self, position: np.ndarray, window: float) -> None:
-        """Progress := the farthest point within ``window`` ahead whose distance to ``position`` is least
-        (a projection on the path near where the robot was, so a neighbouring lane is never taken)."""
+        """Progress := the nearest point of the route to ``position`` at most ``window`` ahead of where
+        it was: no farther than the carrot the robot was given (so a neighbouring ring is never taken,
+        nor, on a pass that doubles back over a small blob, the way back while it is still going out);
+        the first such along the route on a tie."""
+        reach = self.progress + window
         best, best_distance = self.progress, math.inf
         for k in range(len(self.points) - 1):
             start, end = self.along[k], self.along[k + 1]
-            if end < self.progress or start > self.progress + window:
+            if end < self.progress or start > reach:
                 continue
             a, b = self.points[k], self.points[k + 1]
             d = b - a
             span2 = float(d @ d)
             t = 0.0 if span2 == 0.0 else float(np.clip((position - a) @ d / span2, 0.0, 1.0))
-            at = min(max(start + t * (end - start), self.progress), self.progress + window)
+            at = min(max(start + t * (end - start), self.progress), reach)
             gap = float(np.linalg.norm(self.point_at(at) - position))
-            if gap <= best_distance:
+            if gap < best_distance - 1e-9:
                 best, best_distance = at, gap
         self.progress = max(self.progress, best)
 
@@ -234,7 +238,9 @@ def blob_passes(
     lack: np.ndarray, cell: float, lead: float, spacing: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every uncovered blob as a pass along its major axis through its centroid: (M, 2, 2, 2) the two
-    ways to fly it, each (entry ``lead`` before the blob, exit at its far end); (M, 2) the centroids;
+    ways to fly it, each (entry at its near end, or before it so that the pass is at least ``lead``
+    long: a forward camera sees a small blob only from some way off; exit at its far end); (M, 2) the
+    centroids;
     the blob labels of the grid. A blob: the cells with Υ > 0 that lie closer than a lane spacing to
     each other (8-connected once grown by half a spacing), so that the scraps a row of lanes leaves
     along an edge make one pass along it, not one each."""
@@ -254,7 +260,8 @@ def blob_passes(
         axis = np.linalg.eigh(spread.T @ spread)[1][:, -1] if len(points) > 1 else np.array([1.0, 0.0])
         extent = spread @ axis
         low, high = centre + extent.min() * axis, centre + extent.max() * axis
-        ways.append([[low - lead * axis, high], [high + lead * axis, low]])
+        run_up = max(0.0, lead - float(extent.max() - extent.min()))  # a pass is at least ``lead`` long
+        ways.append([[low - run_up * axis, high], [high + run_up * axis, low]])
         centres.append(centre)
     return np.array(ways).reshape(-1, 2, 2, 2), np.array(centres).reshape(-1, 2), labels
 
@@ -279,7 +286,7 @@ class LanePlanner:
             routes = balanced_routes(self.scenario, self.spacing, self._all(ids, positions), self.lead)
             for agent, route in zip(range(self.scenario.agents), routes, strict=True):
                 self.routes[agent] = Route.of(route)
-        window = 4.0 * self.scenario.k_v * CARROT_PERIOD + LOOKAHEAD
+        window = LOOKAHEAD  # no robot is past the carrot it was given (it slows to stop on it)
         free = []
         for index, agent in enumerate(ids):
             route = self.routes[agent]
@@ -303,9 +310,10 @@ class LanePlanner:
     def _give_passes(self, lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]) -> None:
         """Robots done with their route take a pass each over the uncovered blobs, by least total
         distance to the passes' entries; a robot left without one stays where it is."""
-        # No run-up before a pass: measured, entering at the blob's near end finishes sooner (N = 10: 3.10
-        # t* against 3.29 with the piece's run-up; what the pass's start leaves, a later pass takes).
-        ways, centres, labels = blob_passes(self._unclaimed(lack, ids), self.scenario.cell, 0.0, self.spacing)
+        # A pass is entered at the blob's near end, with a run-up only to make it ``lead`` long: measured,
+        # finishing sooner than the pieces' run-up before every pass (N = 10: 3.10 t* against 3.29); a pass
+        # of length 0 over a small blob would park the robot on it, unseen by its forward camera, for ever.
+        ways, centres, labels = blob_passes(self._unclaimed(lack, ids), self.scenario.cell, self.lead, self.spacing)
         self.blobs = BlobObjectives(centres, labels.astype(np.int32))
         for index in free:  # stay, unless given a pass below
             self.routes[ids[index]] = Route.of(positions[index][None, :], cleanup=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linear_sum_assignment
 
+from anicov.engine import run_scenario
 from model.control import pursuit_law
 from model.lane_planner import (
     LOOKAHEAD,
@@ -25,7 +27,7 @@ from model.lane_planner import (
     spiral_pieces,
 )
 from model.metrics import coverage_distance, straight_pass_coverage
-from model.scenario import Scenario, ScenarioError
+from model.scenario import Scenario, ScenarioError, load_scenario
 
 PAPER = Scenario()
 
@@ -105,6 +107,24 @@ def test_progress_follows_the_robot_along_its_route_never_back_and_never_onto_th
     assert np.allclose(route.point_at(route.length + 3.0), [0.0, 8.0])
 
 
+def test_progress_on_a_pass_that_doubles_back_never_takes_the_way_back_for_the_way_out():
+    """A pass over a small blob where the robot stands: out to the entry, back over the blob. Going out,
+    the robot is nearer the way back than the way out; progress stays within the carrot's reach."""
+    route = Route.of(np.array([[24.5, 23.35], [27.2, 23.5], [24.5, 23.5]]))
+    route.advance(np.array([25.6, 23.45]), window=LOOKAHEAD)
+    route.advance(np.array([26.5, 23.5]), window=LOOKAHEAD)
+    assert route.progress < 2.7  # still on the way out (the corner is at 2.70)
+    assert not route.done()
+
+
+def test_a_team_on_a_long_strip_finishes_its_last_small_blobs():
+    """Found on the 200 x 50 strip (R = 10): a one-cell blob left at the end was shuttled over for ever
+    when progress took the pass's way back for its way out (N = 2, seed 1: now complete)."""
+    scenario = load_scenario(Path(__file__).resolve().parent.parent / "scenarios" / "wide.toml")
+    result = run_scenario(scenario.with_overrides(agents=2, seed=1, controller="anicov"), record_trace=False)
+    assert result.completed and result.completion_time < 2.0 * 1274.0  # under 2 t*_2 of the strip
+
+
 def test_a_blob_is_passed_along_its_major_axis_and_scraps_along_an_edge_make_one_pass():
     lack = np.zeros((40, 40))
     lack[5:35, 2:4] = 1.0  # a thin strip along x = 2..4
@@ -114,7 +134,11 @@ def test_a_blob_is_passed_along_its_major_axis_and_scraps_along_an_edge_make_one
     ways, centres, labels = blob_passes(lack, 1.0, lead=3.0, spacing=7.7)
     assert len(ways) == 1 and labels.max() == 1
     entry, exit_ = ways[0][0]
-    assert abs(entry[0] - exit_[0]) < 1.0 and abs(entry[1] - exit_[1]) > 30.0  # along the strip, in y
+    assert abs(entry[0] - exit_[0]) < 1.0 and abs(entry[1] - exit_[1]) == pytest.approx(29.0, abs=0.5)  # along it
+    small = np.zeros((40, 40))
+    small[20, 20] = 0.5
+    (entry, exit_), _ = blob_passes(small, 1.0, lead=3.0, spacing=7.7)[0][0]
+    assert np.linalg.norm(exit_ - entry) == pytest.approx(3.0)  # a one-cell blob: a pass of the run-up's length
     rows, cols = np.nonzero(lack > 0)
     assert centres[0] == pytest.approx((cols.mean() + 0.5, rows.mean() + 0.5))
 
