@@ -106,7 +106,7 @@ def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: 
         agreed = wait_for_peers(bus, stop, parent) if options.no_coordinator else wait_for_agreement(bus, stop, parent)
         if not agreed:
             bus.token.undeclare()
-            return exit_code(node, stop)
+            return stop.exit_code(EXIT_FAILED) if options.no_coordinator else exit_code(node, stop)
     except ScenarioMismatch as error:
         log.error("agent %d refuses to join: %s", options.agent, error)
         bus.token.undeclare()
@@ -126,6 +126,9 @@ def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: 
             run_lockstep_steps(bus, stop, parent)
         else:
             run_realtime_steps(bus, node.scenario.dt / options.speed, stop, parent)
+    except BaseException:
+        traffic.stop()  # its thread must not publish on a session about to close
+        raise
     finally:
         node.robot.stop()  # before the end-of-run exchanges: a real base must not roll on meanwhile
     finish_run(bus, lockstep)
@@ -234,11 +237,19 @@ def wait_for_agreement(bus: Bus, stop: StopFlag, parent: int) -> bool:
     return False
 
 
+PEERS_TIMEOUT = 120.0
+"""No coordinator: seconds an agent waits for every teammate to answer before giving up (as a
+coordinator waits for every hello)."""
+
+
 def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
     """No coordinator: wait until every agent of the team answers with this agent's scenario and map
-    (ScenarioMismatch at the first that does not). False: stopped, or the launcher is gone, before."""
+    (ScenarioMismatch at the first that does not). False: stopped, the launcher gone, or PEERS_TIMEOUT
+    passed (a teammate that died at its start would otherwise keep the others waiting for ever)."""
     node = bus.node
     mine = digest_of(node.scenario)
+    deadline = time.monotonic() + PEERS_TIMEOUT
+    found: dict = {}
     while not stop.stopped:
         found = peer_digests(bus.session, node.keys, node.limits, timeout=HELLO_PERIOD)
         for agent, theirs in sorted(found.items()):
@@ -246,6 +257,12 @@ def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
         if len(found) == node.scenario.agents:
             return True
         if parent_is_gone(parent):
+            return False
+        if time.monotonic() > deadline:
+            missing = sorted(set(range(node.scenario.agents)) - set(found))
+            log.error(
+                "agent %d: agents %s never answered in %.0f s; giving up", node.options.agent, missing, PEERS_TIMEOUT
+            )
             return False
     return False
 

@@ -174,6 +174,8 @@ def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, l
     the one that makes transit, run-up and flight the same for all; the routes with the earliest
     estimated finish (longest transit + run-up + piece) are kept."""
     total = Route.of(spiral_path(scenario, spacing)).length
+    if total <= 0.0:  # a domain within 2·d100 on both sides: one point, every robot goes there
+        return [np.vstack([position, spiral_path(scenario, spacing)[:1]]) for position in positions]
     lengths = np.full(scenario.agents, total / scenario.agents)
     best, best_finish = None, math.inf
     for _ in range(BALANCING_ROUNDS + 1):

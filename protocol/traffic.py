@@ -33,6 +33,8 @@ class TrafficReporter:
         self._thread = threading.Thread(target=self._run, name=f"traffic-{role}-{ident}", daemon=True)
 
     def start(self) -> TrafficReporter:
+        """Start reporting; the rates count from here (not from the wait for the team before it)."""
+        self._started = time.monotonic()
         self._thread.start()
         return self
 
@@ -45,7 +47,9 @@ class TrafficReporter:
             self._publisher.put(encode(self.report()))
 
     def stop(self) -> None:
-        """Stop the thread and publish the final counters (before the session closes)."""
+        """Stop the thread and publish the final counters (before the session closes); once only."""
+        if self._stopped.is_set():
+            return
         self._stopped.set()
         if self._thread.is_alive():
             self._thread.join(timeout=2 * TRAFFIC_PERIOD)
