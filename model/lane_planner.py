@@ -41,6 +41,7 @@ from scipy.optimize import linear_sum_assignment, minimize_scalar
 from model.metrics import coverage_distance, straight_pass_coverage
 from model.objectives import BlobObjectives
 from model.scenario import Scenario
+from model.zigzag import path_between, point_along
 
 Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
 
@@ -98,13 +99,10 @@ class Route:
         return float(self.along[-1])
 
     def point_at(self, distance: float) -> np.ndarray:
+        """The point ``distance`` along the route, held to its ends."""
         if len(self.points) == 1:
             return self.points[0].copy()
-        distance = min(max(distance, 0.0), self.length)
-        segment = min(int(np.searchsorted(self.along, distance, side="right")) - 1, len(self.points) - 2)
-        span = max(self.along[segment + 1] - self.along[segment], 1e-300)
-        share = (distance - self.along[segment]) / span
-        return self.points[segment] + share * (self.points[segment + 1] - self.points[segment])
+        return point_along(self.points, self.along, min(max(distance, 0.0), self.length))
 
     def advance(self, position: np.ndarray, window: float) -> None:
         """Progress := the nearest point of the route to ``position`` at most ``window`` ahead of where
@@ -155,17 +153,15 @@ def spiral_path(scenario: Scenario, spacing: float) -> np.ndarray:
     return np.array(points, dtype=np.float64)
 
 
-def spiral_pieces(scenario: Scenario, spacing: float, cuts: np.ndarray | None = None) -> list[np.ndarray]:
-    """The spiral cut into N pieces (polylines), one per robot: of equal length, or at ``cuts`` (N + 1
-    arc lengths from 0 to the spiral's length)."""
+def spiral_pieces(scenario: Scenario, spacing: float) -> list[np.ndarray]:
+    """The spiral cut into N pieces of equal length (polylines), one per robot."""
     whole = Route.of(spiral_path(scenario, spacing))
-    if cuts is None:
-        cuts = np.linspace(0.0, whole.length, scenario.agents + 1)
-    pieces = []
-    for low, high in itertools.pairwise(cuts):
-        inner = whole.points[(whole.along > low) & (whole.along < high)]
-        pieces.append(np.vstack([whole.point_at(low), inner, whole.point_at(high)]))
-    return pieces
+    return cut(whole, np.linspace(0.0, whole.length, scenario.agents + 1))
+
+
+def cut(whole: Route, cuts: np.ndarray) -> list[np.ndarray]:
+    """A route cut at ``cuts`` (arc lengths from 0 to its length) into consecutive polylines."""
+    return [path_between(whole.points, low, high) for low, high in itertools.pairwise(cuts)]
 
 
 def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, lead: float) -> list[np.ndarray]:
@@ -173,15 +169,16 @@ def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, l
     round assigns robots to pieces (:func:`assign_pieces`), then moves every piece's length halfway to
     the one that makes transit, run-up and flight the same for all; the routes with the earliest
     estimated finish (longest transit + run-up + piece) are kept."""
-    total = Route.of(spiral_path(scenario, spacing)).length
+    whole = Route.of(spiral_path(scenario, spacing))
+    total = whole.length
     if total <= 0.0:  # a domain within 2·d100 on both sides: one point, every robot goes there
-        return [np.vstack([position, spiral_path(scenario, spacing)[:1]]) for position in positions]
+        return [np.vstack([position, whole.points[:1]]) for position in positions]
     lengths = np.full(scenario.agents, total / scenario.agents)
     best, best_finish = None, math.inf
     for _ in range(BALANCING_ROUNDS + 1):
         cuts = np.concatenate([[0.0], np.cumsum(lengths)])
         cuts[-1] = total
-        pieces = spiral_pieces(scenario, spacing, cuts)
+        pieces = cut(whole, cuts)
         routes, owners = assign_pieces(pieces, positions, lead, with_owners=True)
         transit = np.array(
             [np.linalg.norm(routes[owners[k]][1] - positions[owners[k]]) + lead for k in range(len(pieces))]
@@ -242,8 +239,7 @@ def blob_passes(
     """Every uncovered blob as a pass along its major axis through its centroid: (M, 2, 2, 2) the two
     ways to fly it, each (entry at its near end, or before it so that the pass is at least ``lead``
     long: a forward camera sees a small blob only from some way off; exit at its far end); (M, 2) the
-    centroids;
-    the blob labels of the grid. A blob: the cells with Υ > 0 that lie closer than a lane spacing to
+    centroids; the blob labels of the grid. A blob: the cells with Υ > 0 that lie closer than a lane spacing to
     each other (8-connected once grown by half a spacing), so that the scraps a row of lanes leaves
     along an edge make one pass along it, not one each."""
     uncovered = (lack > 0.0).astype(np.uint8)

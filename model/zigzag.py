@@ -97,10 +97,11 @@ def path_between(waypoints: np.ndarray, start: float, end: float) -> np.ndarray:
     """The stretch of a polyline between two distances along it (start < end), as a polyline."""
     along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1))])
     inner = waypoints[(along > start) & (along < end)]
-    return np.vstack([_point_at(waypoints, along, start), inner, _point_at(waypoints, along, end)])
+    return np.vstack([point_along(waypoints, along, start), inner, point_along(waypoints, along, end)])
 
 
-def _point_at(waypoints: np.ndarray, along: np.ndarray, distance: float) -> np.ndarray:
+def point_along(waypoints: np.ndarray, along: np.ndarray, distance: float) -> np.ndarray:
+    """The point ``distance`` along a polyline whose cumulative arc lengths are ``along``."""
     segment = min(int(np.searchsorted(along, distance, side="right")) - 1, len(waypoints) - 2)
     share = (distance - along[segment]) / max(along[segment + 1] - along[segment], 1e-300)
     return waypoints[segment] + share * (waypoints[segment + 1] - waypoints[segment])
@@ -121,8 +122,8 @@ def boustrophedon_pilots(scenario: Scenario, poses: np.ndarray) -> list[Waypoint
     path = zigzag_waypoints(scenario.domain[0], lanes, scenario.range, 0)
     along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
     cuts = np.linspace(0.0, along[-1], scenario.agents + 1)
-    firsts = np.array([_point_at(path, along, cut) for cut in cuts[:-1]])
-    lasts = np.array([_point_at(path, along, cut) for cut in cuts[1:]])
+    firsts = np.array([point_along(path, along, cut) for cut in cuts[:-1]])
+    lasts = np.array([point_along(path, along, cut) for cut in cuts[1:]])
     starts = np.asarray(poses)[:, :2]
     to_first = np.linalg.norm(starts[:, None, :] - firsts[None], axis=2)
     to_last = np.linalg.norm(starts[:, None, :] - lasts[None], axis=2)
