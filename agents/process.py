@@ -35,6 +35,7 @@ from model.scenario import Scenario
 from protocol.agreement import (
     ScenarioMismatch,
     check_agreement,
+    check_peers,
     coordinator_digest,
     digest_of,
     peer_digests,
@@ -252,8 +253,7 @@ def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
     found: dict = {}
     while not stop.stopped:
         found = peer_digests(bus.session, node.keys, node.limits, timeout=HELLO_PERIOD)
-        for agent, theirs in sorted(found.items()):
-            check_agreement(mine, theirs, node.scenario, whose=f"agent {agent}'s")
+        check_peers(mine, found, node.scenario)
         if len(found) == node.scenario.agents:
             return True
         if parent_is_gone(parent):

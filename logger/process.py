@@ -21,7 +21,14 @@ import zenoh
 from logger.team_logger import LoggerOptions, TeamLogger
 from model.exact_coverage import load_kernels as load_event_kernel
 from model.scenario import Scenario
-from protocol.agreement import ScenarioMismatch, check_agreement, coordinator_digest, digest_of, peer_digests
+from protocol.agreement import (
+    ScenarioMismatch,
+    check_agreement,
+    check_peers,
+    coordinator_digest,
+    digest_of,
+    peer_digests,
+)
 from protocol.keys import TeamKeys
 from protocol.recovery import fetch, fetch_snapshot
 from protocol.session import open_session
@@ -87,8 +94,7 @@ def _await_agreement(session: zenoh.Session, keys: TeamKeys, node: TeamLogger, s
     while not stopped():
         if node.options.no_coordinator:
             found = peer_digests(session, keys, node.limits, timeout=0.2)
-            for agent, theirs in sorted(found.items()):
-                check_agreement(mine, theirs, node.scenario, whose=f"agent {agent}'s")
+            check_peers(mine, found, node.scenario)
             if found:
                 return
             continue

@@ -44,37 +44,45 @@ def serve_digest(session: zenoh.Session, key: str, digest: ScenarioDigest) -> ze
     return session.declare_queryable(key, lambda query: query.reply(key, payload))
 
 
-def peer_digests(session: zenoh.Session, keys: TeamKeys, limits: Limits, timeout: float) -> dict[int, ScenarioDigest]:
-    """A team with no coordinator: the digest of every agent that answers on agent/<id>/scenario."""
-    found: dict[int, ScenarioDigest] = {}
-    for reply in session.get(keys.all_agent_scenarios, timeout=timeout):
+def _digests(
+    session: zenoh.Session, key: str, limits: Limits, timeout: float, whose: str
+) -> list[tuple[str, ScenarioDigest]]:
+    """Every valid digest answered on ``key`` within ``timeout`` seconds, with the key it came on; a
+    malformed answer is logged and left out."""
+    found = []
+    for reply in session.get(key, timeout=timeout):
         if reply.ok is None:
             continue
-        agent = agent_of_key(str(reply.ok.key_expr))
         try:
             message = decode(reply.ok.payload.to_bytes(), limits, expected="scenario")
         except ProtocolError as error:
-            log.warning("rejected a teammate's scenario digest: %s", error)
+            log.warning("rejected %s scenario digest: %s", whose, error)
             continue
-        if agent is not None and 0 <= agent < limits.agents:
-            assert isinstance(message, ScenarioDigest)
-            found[agent] = message
+        assert isinstance(message, ScenarioDigest)
+        found.append((str(reply.ok.key_expr), message))
     return found
+
+
+def peer_digests(session: zenoh.Session, keys: TeamKeys, limits: Limits, timeout: float) -> dict[int, ScenarioDigest]:
+    """A team with no coordinator: the digest of every agent that answers on agent/<id>/scenario."""
+    found: dict[int, ScenarioDigest] = {}
+    for key, digest in _digests(session, keys.all_agent_scenarios, limits, timeout, "a teammate's"):
+        agent = agent_of_key(key)
+        if agent is not None and 0 <= agent < limits.agents:
+            found[agent] = digest
+    return found
+
+
+def check_peers(mine: ScenarioDigest, found: dict[int, ScenarioDigest], scenario: Scenario) -> None:
+    """Raise ScenarioMismatch at the first teammate (by id) that does not run what this process loaded."""
+    for agent, theirs in sorted(found.items()):
+        check_agreement(mine, theirs, scenario, whose=f"agent {agent}'s")
 
 
 def coordinator_digest(session: zenoh.Session, keys: TeamKeys, limits: Limits, timeout: float) -> ScenarioDigest | None:
     """The coordinator's digest, or None if no coordinator answered within ``timeout`` seconds."""
-    for reply in session.get(keys.scenario, timeout=timeout):
-        if reply.ok is None:
-            continue
-        try:
-            message = decode(reply.ok.payload.to_bytes(), limits, expected="scenario")
-        except ProtocolError as error:
-            log.warning("rejected the coordinator's scenario digest: %s", error)
-            continue
-        assert isinstance(message, ScenarioDigest)
-        return message
-    return None
+    found = _digests(session, keys.scenario, limits, timeout, "the coordinator's")
+    return found[0][1] if found else None
 
 
 def check_agreement(
