@@ -269,14 +269,14 @@ class RunRecorder:
         self.stream.log(f"bus/{process}/bytes_in", rr.Scalars(bytes_in_per_second))
         self.stream.log(f"bus/{process}/bytes_out", rr.Scalars(bytes_out_per_second))
 
-    def bandwidth_table(self, step: int, rows: list[tuple[str, float, int, int]]) -> None:
-        """Each process's totals: (process, wall seconds, bytes out, bytes in)."""
+    def bandwidth_table(self, step: int, bandwidth: dict[str, dict[str, float]]) -> None:
+        """Each process's totals and rates, as TeamLogger.bandwidth gives them."""
         self._at(step)
         lines = ["| process | seconds | bytes out | bytes in | out B/s | in B/s |", "|---|---|---|---|---|---|"]
-        for process, seconds, bytes_out, bytes_in in rows:
-            per = 1.0 / seconds if seconds > 0 else 0.0
+        for process, row in bandwidth.items():
             lines.append(
-                f"| {process} | {seconds:.1f} | {bytes_out} | {bytes_in} | {bytes_out * per:.0f} | {bytes_in * per:.0f} |"
+                f"| {process} | {row['seconds']:.1f} | {row['bytes_out']} | {row['bytes_in']} | "
+                f"{row['bytes_out_per_second']:.0f} | {row['bytes_in_per_second']:.0f} |"
             )
         self.stream.log(
             "run/bandwidth", rr.TextDocument("\n".join(["# Bandwidth", *lines]), media_type="text/markdown")

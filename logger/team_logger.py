@@ -178,6 +178,5 @@ class TeamLogger:
             text = "logger stopped before the end of the run"
         self.recorder.event(final_step, text)
         if self.traffic:
-            rows = [(name, row["seconds"], row["bytes_out"], row["bytes_in"]) for name, row in self.bandwidth().items()]
-            self.recorder.bandwidth_table(final_step, rows)
+            self.recorder.bandwidth_table(final_step, self.bandwidth())
         self.recorder.close()
