@@ -5,7 +5,10 @@ p to a cell centre c crosses an occupied square Q only if c's bearing lies in Q'
 from p and c is farther than Q's nearest point. The wedge's bearings (±F, plus a bin each side) are
 cut into SHADOW_BINS bins; each bin keeps the nearest distance of the occupied squares (and teammates'
 disks, :func:`add_teammate_shadows`) of the wedge's
-window whose angular span (widened by a bin each side) meets it, and, for the bins a bin inside a
+window whose angular span (widened by a bin each side) meets it (a square beside the robot spans only
+its part in front, up to ±90° on its side: a segment to a cell in front never enters the part behind; a
+square with no corner in front is left out, unless the robot stands on its edge: then it spans every bin), and,
+for the bins a bin inside a
 square's span, the distance of its farthest corner: a ray there crosses the square's inside, so a cell
 beyond is hidden without a traversal. Squares farther than R, and squares whose four neighbours are
 occupied (a segment reaches one only through a neighbour, unless it ends there), are left out. A cell nearer than its bin's distance
@@ -62,8 +65,12 @@ def wall_shadows(
             if nearest2 > reach2:
                 continue
             smallest, largest, farthest2, behind = _square_span(left, bottom, cell, heading_x, heading_y)
-            if behind:  # beside the robot: it may hide any bearing, and hides none for sure
+            if nearest2 == 0.0:
+                # The robot stands on its edge: the traversal's tie rules (a segment from a grid corner)
+                # may test it whatever the bearing.
                 first, last = 0, SHADOW_BINS - 1
+            elif smallest > largest:
+                continue  # wholly behind the robot: a segment to a cell in front never enters it
             else:
                 first, last = pseudo_bin(smallest, half_angle) - 1, pseudo_bin(largest, half_angle) + 1
             for k in range(max(first, 0), min(last, SHADOW_BINS - 1) + 1):
@@ -84,22 +91,39 @@ def wall_shadows(
 def _square_span(
     left: float, bottom: float, cell: float, heading_x: float, heading_y: float
 ) -> tuple[float, float, float, bool]:
-    """(smallest and largest pseudo-angle of the square's corners in front, squared distance of its
-    farthest corner, whether a corner is beside or behind the robot), corners relative to the robot."""
+    """(smallest and largest pseudo-angle of the square's part in front of the robot, squared distance of
+    its farthest corner, whether a corner is beside or behind the robot), corners relative to the robot.
+
+    That part is bounded by the square's corners in front and, for a square that reaches beside the robot,
+    by the points where its edges cross the robot's sideways line (along = 0): a bearing of ±90°,
+    pseudo-angle ±1 on the side of the crossing. A crossing at the robot itself (within 1e-9: the robot on
+    the square's edge) counts on both sides, so every bearing is spanned. A square with no corner in front
+    has no part there: smallest > largest (a segment to a cell in front never enters it)."""
+    corners_x = (left, left + cell, left + cell, left)  # counter-clockwise: edge k joins corners k and k + 1
+    corners_y = (bottom, bottom, bottom + cell, bottom + cell)
     smallest, largest, farthest2, behind = math.inf, -math.inf, 0.0, False
-    for corner_x, corner_y in (
-        (left, bottom),
-        (left + cell, bottom),
-        (left, bottom + cell),
-        (left + cell, bottom + cell),
-    ):
+    for k in range(4):
+        corner_x, corner_y = corners_x[k], corners_y[k]
         along = corner_x * heading_x + corner_y * heading_y
         across = heading_x * corner_y - heading_y * corner_x
-        behind = behind or along <= 0.0
+        farthest2 = max(farthest2, corner_x * corner_x + corner_y * corner_y)
         if along > 0.0:
             bearing = across / (along + abs(across))
             smallest, largest = min(smallest, bearing), max(largest, bearing)
-        farthest2 = max(farthest2, corner_x * corner_x + corner_y * corner_y)
+            continue
+        behind = True
+        for other in ((k + 1) % 4, (k + 3) % 4):  # the two edges from this corner
+            other_along = corners_x[other] * heading_x + corners_y[other] * heading_y
+            if other_along <= 0.0:
+                continue
+            other_across = heading_x * corners_y[other] - heading_y * corners_x[other]
+            crossing = across + (other_across - across) * along / (along - other_along)
+            if crossing >= -1e-9:
+                largest = 1.0
+                smallest = min(smallest, 1.0)
+            if crossing <= 1e-9:
+                smallest = -1.0
+                largest = max(largest, -1.0)
     return smallest, largest, farthest2, behind
 
 

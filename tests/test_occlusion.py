@@ -36,3 +36,29 @@ def test_the_pruned_wedge_hides_exactly_what_the_rule_hides(seed, theta, radius)
     for i, j in zip(*np.nonzero(everything), strict=True):
         visible = line_of_sight(occupied, x, y, (col0 + j + 0.5), (row0 + i + 0.5), 1.0, others, radius)
         assert seen[i, j] == (everything[i, j] if visible else 0)
+
+
+@settings(max_examples=300)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.integers(40, 120),
+    st.integers(40, 120),
+    st.sampled_from([k * math.pi / 8 for k in range(-8, 8)] + [math.atan2(1, 2), math.atan2(-2, 1)]),
+)
+def test_pruning_is_exact_on_grid_lines_corners_and_diagonals(seed, quarter_x, quarter_y, theta):
+    """Robots on cell edges, corners and centres, looking along axes and diagonals: segments through
+    grid corners and along grid lines, where the traversal's tie rules decide, and squares beside the
+    robot whose edges cross its sideways line."""
+    rng = np.random.default_rng(seed)
+    occupied = rng.random((40, 40)) < 0.15
+    x, y = quarter_x / 4.0, quarter_y / 4.0
+    occupied[int(y), int(x)] = False
+    coverage = np.zeros((40, 40), dtype=np.int64)
+    ground = Ground(occupied, ~occupied, 0.0, 0.0, 0.0, False, True, True, 20)
+    positions = np.array([[x, y]])
+    *_, row0, col0, seen = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, positions, 0)
+    blind = ground._replace(occlusion=False)
+    *_, _, _, everything = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, blind, NO_POSITIONS, 0)
+    for i, j in zip(*np.nonzero(everything), strict=True):
+        visible = line_of_sight(occupied, x, y, (col0 + j + 0.5), (row0 + i + 0.5), 1.0, NO_POSITIONS, 0.0)
+        assert seen[i, j] == (everything[i, j] if visible else 0)
