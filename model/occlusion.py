@@ -170,7 +170,10 @@ def add_teammate_shadows(
     shadows: np.ndarray, teammates: np.ndarray, radius: float, x: float, y: float, theta: float, half_angle: float
 ) -> None:
     """Mark the bins a teammate's disk may hide, from its nearest point on: the bearings of its two
-    tangents (a bin more each side), all bins for a disk that reaches beside the robot."""
+    tangents (a bin more each side), cut to the robot's front half (a segment to a cell in front has a
+    bearing there): a disk that reaches beside the robot spans up to ±90° on its side, one wholly behind
+    it spans nothing. (``teammates`` are never within 2r, so the robot is never inside a disk.)"""
+    quarter = 0.5 * math.pi
     for k in range(teammates.shape[0]):
         dx, dy = teammates[k, 0] - x, teammates[k, 1] - y
         gap = math.hypot(dx, dy)
@@ -178,17 +181,19 @@ def add_teammate_shadows(
         centre = math.atan2(dy, dx) - theta
         centre = math.atan2(math.sin(centre), math.cos(centre))
         half = math.asin(min(radius / gap, 1.0))
-        if abs(centre) + half >= 0.5 * math.pi - 1e-9:
-            first, last = 0, SHADOW_BINS - 1
-        else:
-            first = pseudo_bin(_pseudo(centre - half), half_angle) - 1
-            last = pseudo_bin(_pseudo(centre + half), half_angle) + 1
+        low, high = max(centre - half, -quarter), min(centre + half, quarter)
+        if low > high:
+            continue  # behind the robot (an interval past ±180° wraps round behind it too)
+        first = pseudo_bin(_pseudo(low), half_angle) - 1
+        last = pseudo_bin(_pseudo(high), half_angle) + 1
         for b in range(max(first, 0), min(last, SHADOW_BINS - 1) + 1):
             shadows[0, b] = min(shadows[0, b], nearest2)
 
 
 @njit(cache=True)
 def _pseudo(angle: float) -> float:
-    """The pseudo-angle of :func:`pseudo_bin` of a bearing in (−90°, 90°)."""
+    """The pseudo-angle of :func:`pseudo_bin` of a bearing in [−90°, 90°] (±1 at ±90°)."""
+    if abs(angle) >= 0.5 * math.pi:
+        return 1.0 if angle > 0.0 else -1.0
     slope = math.tan(angle)
     return slope / (1.0 + abs(slope))

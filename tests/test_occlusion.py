@@ -23,7 +23,12 @@ def test_the_pruned_wedge_hides_exactly_what_the_rule_hides(seed, theta, radius)
     occupied = rng.random((40, 40)) < 0.04
     x, y = rng.uniform(10.0, 30.0, 2)
     occupied[int(y), int(x)] = False  # the robot never stands in an occupied cell
-    positions = np.array([[x, y], *rng.uniform(0.0, 40.0, (3, 2))])
+    # Teammates anywhere, and close round the robot (beside and behind it too, where disks cross its
+    # sideways line).
+    around = rng.uniform(1.2, 4.0, 3)[:, None] * np.stack(
+        [np.cos(angles := rng.uniform(-np.pi, np.pi, 3)), np.sin(angles)], 1
+    )
+    positions = np.array([[x, y], *rng.uniform(0.0, 40.0, (3, 2)), *(np.array([x, y]) + around)])
     coverage = np.zeros((40, 40), dtype=np.int64)
     ground = Ground(occupied, ~occupied, radius, radius, radius, False, True, True, 20)
     blind = ground._replace(occlusion=False)
@@ -61,4 +66,24 @@ def test_pruning_is_exact_on_grid_lines_corners_and_diagonals(seed, quarter_x, q
     *_, _, _, everything = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, blind, NO_POSITIONS, 0)
     for i, j in zip(*np.nonzero(everything), strict=True):
         visible = line_of_sight(occupied, x, y, (col0 + j + 0.5), (row0 + i + 0.5), 1.0, NO_POSITIONS, 0.0)
+        assert seen[i, j] == (everything[i, j] if visible else 0)
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.floats(-math.pi, math.pi))
+def test_teammates_beside_and_behind_hide_exactly_what_the_rule_hides(seed, theta):
+    """No wall: only teammates' disks prune, close round the robot, in front, beside and behind it."""
+    rng = np.random.default_rng(seed)
+    occupied = np.zeros((40, 40), dtype=np.bool_)
+    x, y = rng.uniform(15.0, 25.0, 2)
+    angles = rng.uniform(-np.pi, np.pi, 5)
+    around = rng.uniform(1.2, 5.0, 5)[:, None] * np.stack([np.cos(angles), np.sin(angles)], 1)
+    positions = np.array([[x, y], *(np.array([x, y]) + around)])
+    coverage = np.zeros((40, 40), dtype=np.int64)
+    ground = Ground(occupied, ~occupied, 0.6, 0.6, 0.6, False, True, True, 20)
+    *_, row0, col0, seen = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, positions, 0)
+    blind = ground._replace(occlusion=False)
+    *_, _, _, everything = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, blind, NO_POSITIONS, 0)
+    for i, j in zip(*np.nonzero(everything), strict=True):
+        visible = line_of_sight(occupied, x, y, (col0 + j + 0.5), (row0 + i + 0.5), 1.0, positions[1:], 0.6)
         assert seen[i, j] == (everything[i, j] if visible else 0)
