@@ -2,7 +2,10 @@
 
 Both run the paper scenario from the same seeded poses and fixed objectives
 (the planner is left out so that the figure is the control step alone), in
-the same process, one after the other. Prints a Markdown table.
+the same process, one after the other. Prints Markdown tables: that one; the
+warehouse map with fixed objectives; the kernel inside whole runs on each
+shipped map against the empty domain (issue 11's cost of occlusion); the
+safety filter's cost (issue 12).
 """
 
 from __future__ import annotations
@@ -10,12 +13,15 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from anicov import engine
 from anicov.engine import advance_team, run_scenario
 from anicov.run_parts import objective_fields
 from bench.machine import describe_machine
@@ -92,6 +98,8 @@ def main() -> None:
         print(f"| {agents} | {empty:,.0f} | {off:,.0f} | {on:,.0f} | {empty / on:.2f}× the cost |")
 
     print()
+    terrain_in_runs_table()
+    print()
     safety_table(args.steps)
 
 
@@ -106,6 +114,58 @@ def run_rate(agents: int, seeds: int, **overrides: object) -> float:
         elapsed += time.perf_counter() - started
         agent_steps += result.steps * agents
     return agent_steps / elapsed
+
+
+@contextmanager
+def kernel_clock() -> Iterator[list[float]]:
+    """Time spent in the engine's control kernel (``advance_team``) and agent-steps it made, as [seconds,
+    agent-steps], while the block runs: the planner, the fields and the bookkeeping are left out."""
+    totals = [0.0, 0.0]
+    kernel = engine.advance_team
+
+    def timed(*args: object) -> tuple[int, int, int]:
+        started = time.perf_counter()
+        done = kernel(*args)
+        totals[0] += time.perf_counter() - started
+        totals[1] += done[0] * args[1].shape[0]  # steps done x agents (args[1]: the poses)
+        return done
+
+    engine.advance_team = timed
+    try:
+        yield totals
+    finally:
+        engine.advance_team = kernel
+
+
+def kernel_rate_in_runs(scenario_path: Path, agents: int, seeds: int, **overrides: object) -> float:
+    """Agent-steps/s of the control kernel over whole runs (seeds 0..), objectives from Algorithms 1-2."""
+    run_scenario(load_scenario(scenario_path).with_overrides(agents=agents, max_time=1.0, **overrides))  # compile
+    with kernel_clock() as totals:
+        for seed in range(seeds):
+            scenario = load_scenario(scenario_path).with_overrides(agents=agents, seed=seed, **overrides)
+            run_scenario(scenario, record_trace=False)
+    return totals[1] / totals[0]
+
+
+def terrain_in_runs_table(seeds: int = 3) -> None:
+    """Issue 11's cost in the state runs are in: the kernel over whole runs on each shipped map (robots of
+    radius 0.4, no filter, as docs/terrain measures them) against the empty domain's, same N and seeds.
+    The fixed-objective table above sends every robot to one point, which is covered within a minute;
+    from then on every robot stands and searches R for an uncovered cell in sight, every step, a state a
+    run leaves at its next replan (Algorithm 1 drops an objective whose cell is covered)."""
+    print(
+        f"| team N | map | empty domain agent-steps/s | occlusion off | occlusion on | on / empty | whole runs, seeds 0-{seeds - 1} |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    for agents in (4, 10):
+        empty = kernel_rate_in_runs(PAPER_SCENARIO, agents, seeds)
+        for name in ("warehouse", "office", "field"):
+            path = PAPER_SCENARIO.parent / f"{name}.toml"
+            off = kernel_rate_in_runs(path, agents, seeds, occlusion=False, safety=False)
+            on = kernel_rate_in_runs(path, agents, seeds, safety=False)
+            print(
+                f"| {agents} | {name} | {empty:,.0f} | {off:,.0f} | {on:,.0f} | {empty / on:.2f}× the cost | kernel only |"
+            )
 
 
 def safety_table(steps: int) -> None:
