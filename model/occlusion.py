@@ -5,10 +5,10 @@ p to a cell centre c crosses an occupied square Q only if c's bearing lies in Q'
 from p and c is farther than Q's nearest point. The wedge's bearings (±F, plus a bin each side) are
 cut into SHADOW_BINS bins; each bin keeps the nearest distance of the occupied squares (and teammates'
 disks, :func:`add_teammate_shadows`) of the wedge's
-window whose angular span (widened by a bin each side) meets it (a square beside the robot spans only
+window whose angular span (widened by PSEUDO_SLACK) meets it (a square beside the robot spans only
 its part in front, up to ±90° on its side: a segment to a cell in front never enters the part behind; a
 square with no corner in front is left out, unless the robot stands on its edge: then it spans every bin), and,
-for the bins a bin inside a
+for the bins wholly inside a
 square's span, the distance of its farthest corner: a ray there crosses the square's inside, so a cell
 beyond is hidden without a traversal. Squares farther than R, and squares whose four neighbours are
 occupied (a segment reaches one only through a neighbour, unless it ends there), are left out. A cell nearer than its bin's distance
@@ -27,6 +27,13 @@ from numba import njit
 from model.ground import Ground
 
 SHADOW_BINS = 64
+PSEUDO_SLACK = 1e-9
+"""How far, in pseudo-angle, a square's span is widened before it is binned: far more than the rounding
+of a corner's or a cell centre's pseudo-angle (~1e-16), so a cell on the bearing of a square's edge or
+corner is still in a bin the square marks. (Until 2026-12-03 a whole bin each side: half the visible
+cells that went to the exact traversal on the warehouse map went there only for that bin.)"""
+ANGLE_SLACK = 1e-9
+"""The same for a teammate's tangents, in radians."""
 
 
 @njit(cache=True)
@@ -72,16 +79,17 @@ def wall_shadows(
             elif smallest > largest:
                 continue  # wholly behind the robot: a segment to a cell in front never enters it
             else:
-                first, last = pseudo_bin(smallest, half_angle) - 1, pseudo_bin(largest, half_angle) + 1
+                first = pseudo_bin(smallest - PSEUDO_SLACK, half_angle)
+                last = pseudo_bin(largest + PSEUDO_SLACK, half_angle)
             for k in range(max(first, 0), min(last, SHADOW_BINS - 1) + 1):
                 shadows[0, k] = min(shadows[0, k], nearest2)
             if behind:
                 continue
-            # Bins a bin inside the span: every ray there crosses the square's inside, so a cell beyond
-            # its farthest corner is hidden for sure.
+            # Bins wholly inside the span (past the bins of its ends, slack included): every ray there
+            # crosses the square's inside, so a cell beyond its farthest corner is hidden for sure.
             for k in range(
-                max(pseudo_bin(smallest, half_angle) + 2, 0),
-                min(pseudo_bin(largest, half_angle) - 2, SHADOW_BINS - 1) + 1,
+                max(pseudo_bin(smallest + PSEUDO_SLACK, half_angle) + 1, 0),
+                min(pseudo_bin(largest - PSEUDO_SLACK, half_angle) - 1, SHADOW_BINS - 1) + 1,
             ):
                 shadows[1, k] = min(shadows[1, k], farthest2)
     return shadows
@@ -170,7 +178,7 @@ def add_teammate_shadows(
     shadows: np.ndarray, teammates: np.ndarray, radius: float, x: float, y: float, theta: float, half_angle: float
 ) -> None:
     """Mark the bins a teammate's disk may hide, from its nearest point on: the bearings of its two
-    tangents (a bin more each side), cut to the robot's front half (a segment to a cell in front has a
+    tangents (widened by ANGLE_SLACK), cut to the robot's front half (a segment to a cell in front has a
     bearing there): a disk that reaches beside the robot spans up to ±90° on its side, one wholly behind
     it spans nothing. (``teammates`` are never within 2r, so the robot is never inside a disk.)"""
     quarter = 0.5 * math.pi
@@ -184,8 +192,8 @@ def add_teammate_shadows(
         low, high = max(centre - half, -quarter), min(centre + half, quarter)
         if low > high:
             continue  # behind the robot (an interval past ±180° wraps round behind it too)
-        first = pseudo_bin(_pseudo(low), half_angle) - 1
-        last = pseudo_bin(_pseudo(high), half_angle) + 1
+        first = pseudo_bin(_pseudo(low - ANGLE_SLACK), half_angle)
+        last = pseudo_bin(_pseudo(high + ANGLE_SLACK), half_angle)
         for b in range(max(first, 0), min(last, SHADOW_BINS - 1) + 1):
             shadows[0, b] = min(shadows[0, b], nearest2)
 

@@ -87,3 +87,24 @@ def test_teammates_beside_and_behind_hide_exactly_what_the_rule_hides(seed, thet
     for i, j in zip(*np.nonzero(everything), strict=True):
         visible = line_of_sight(occupied, x, y, (col0 + j + 0.5), (row0 + i + 0.5), 1.0, positions[1:], 0.6)
         assert seen[i, j] == (everything[i, j] if visible else 0)
+
+
+def test_a_diagonal_through_grid_corners_is_pruned_as_the_traversal_decides():
+    """A case found by a search over quarter-cell positions: the segment from (24.75, 15.25) to the centre
+    of cell (9, 30) runs exactly through grid corners, and without a slack on the squares' spans (the bins
+    they mark) the pruning called a cell in sight that the traversal's corner rule hides."""
+    occupied = np.random.default_rng(1721).random((40, 40)) < 0.15
+    x, y, theta = 24.75, 15.25, -math.pi / 4
+    occupied[int(y), int(x)] = False
+    coverage = np.zeros((40, 40), dtype=np.int64)
+    ground = Ground(occupied, ~occupied, 0.0, 0.0, 0.0, False, True, True, 20)
+    *_, row0, col0, seen = sense_wedge(
+        coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, np.array([[x, y]]), 0
+    )
+    blind = ground._replace(occlusion=False)
+    *_, _, _, everything = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, blind, NO_POSITIONS, 0)
+    assert not line_of_sight(occupied, x, y, 30.5, 9.5, 1.0, NO_POSITIONS, 0.0)
+    assert everything[9 - row0, 30 - col0] > 0 and seen[9 - row0, 30 - col0] == 0
+    for i, j in zip(*np.nonzero(everything), strict=True):
+        visible = line_of_sight(occupied, x, y, (col0 + j + 0.5), (row0 + i + 0.5), 1.0, NO_POSITIONS, 0.0)
+        assert seen[i, j] == (everything[i, j] if visible else 0)
