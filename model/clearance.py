@@ -81,28 +81,36 @@ def swept_disk_is_free(
 ) -> bool:
     """Whether the disk stays free along the segment (x0, y0) → (x1, y1), exactly: no occupied cell's
     square comes closer than ``radius`` to the segment (and, ``bounded``, both ends keep the disk on the
-    grid, which then holds for the whole segment). Only cells within ⌈(radius + cell/4)/cell⌉ of a cell
-    holding a point of the segment sampled every quarter cell can be that close: those are tested."""
+    grid, which then holds for the whole segment). A square that close lies in a row the segment comes
+    within ``radius`` of, and within ``radius`` of the part of the segment in that row's band: row by row,
+    the squares of that stretch (a cell more each side, for rounding) get the exact test."""
     rows, cols = occupied.shape
     if bounded and not (_on_grid(x0, y0, radius, rows, cols, cell) and _on_grid(x1, y1, radius, rows, cols, cell)):
         return False
-    reach = max(1, math.ceil((radius + 0.25 * cell) / cell))
-    length = math.hypot(x1 - x0, y1 - y0)
-    # Cells along the segment, sampled every quarter cell: every cell it passes through is visited.
-    samples = max(1, math.ceil(4.0 * length / cell))
-    last_row, last_col = -(10**9), -(10**9)
-    for k in range(samples + 1):
-        t = k / samples
-        row, col = math.floor((y0 + t * (y1 - y0)) / cell), math.floor((x0 + t * (x1 - x0)) / cell)
-        if row == last_row and col == last_col:
-            continue
-        last_row, last_col = row, col
-        for r in range(max(row - reach, 0), min(row + reach + 1, rows)):
-            for c in range(max(col - reach, 0), min(col + reach + 1, cols)):
-                if occupied[r, c] and _segment_square_distance2(
-                    x0, y0, x1, y1, c * cell, r * cell, (c + 1) * cell, (r + 1) * cell
-                ) < max(radius * radius, 1e-300):
-                    return False
+    reach2 = max(radius * radius, 1e-300)
+    dx, dy = x1 - x0, y1 - y0
+    row_lo = max(math.floor((min(y0, y1) - radius) / cell) - 1, 0)
+    row_hi = min(math.floor((max(y0, y1) + radius) / cell) + 1, rows - 1)
+    for row in range(row_lo, row_hi + 1):
+        # The stretch of the segment whose y lies within radius of this row's band [row, row + 1) cells.
+        band_lo, band_hi = row * cell - radius, (row + 1) * cell + radius
+        if dy == 0.0:
+            if y0 < band_lo or y0 > band_hi:
+                continue
+            t_lo, t_hi = 0.0, 1.0
+        else:
+            t_lo, t_hi = (band_lo - y0) / dy, (band_hi - y0) / dy
+            t_lo, t_hi = max(min(t_lo, t_hi), 0.0), min(max(t_lo, t_hi), 1.0)
+            if t_lo > t_hi:
+                continue
+        x_lo, x_hi = min(x0 + t_lo * dx, x0 + t_hi * dx), max(x0 + t_lo * dx, x0 + t_hi * dx)
+        col_lo = max(math.floor((x_lo - radius) / cell) - 1, 0)
+        col_hi = min(math.floor((x_hi + radius) / cell) + 1, cols - 1)
+        for col in range(col_lo, col_hi + 1):
+            if occupied[row, col] and _segment_square_distance2(
+                x0, y0, x1, y1, col * cell, row * cell, (col + 1) * cell, (row + 1) * cell
+            ) < reach2:
+                return False
     return True
 
 

@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.clearance import disk_is_free, step_or_stay, swept_disk_is_free
+from model.clearance import _segment_square_distance2, disk_is_free, step_or_stay, swept_disk_is_free
 
 
 def corridor() -> np.ndarray:
@@ -67,3 +67,30 @@ def test_the_swept_disk_test_is_exact_against_dense_sampling(seed, radius):
         assert all(disk_is_free(occupied, x, y, radius * (1 - 1e-6), 1.0, False) for x, y in samples)
     else:  # some sample's disk, a hair larger, does
         assert not all(disk_is_free(occupied, x, y, radius + 0.01, 1.0, False) for x, y in samples)
+
+
+@settings(max_examples=300)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.sampled_from([0.0, 0.05, 0.4, 0.45, 1.0, 2.3]),
+    st.sampled_from(["any", "horizontal", "vertical", "on lines"]),
+)
+def test_the_swept_disk_test_answers_as_every_square_tested(seed, radius, kind):
+    """Row by row, the squares it tests are all those that can matter: the answer is that of the exact
+    test on every occupied square of the map (segments along and on grid lines included)."""
+    rng = np.random.default_rng(seed)
+    occupied = rng.random((16, 16)) < 0.12
+    (x0, y0), (x1, y1) = rng.uniform(0.0, 16.0, (2, 2))
+    if kind == "horizontal":
+        y1 = y0
+    elif kind == "vertical":
+        x1 = x0
+    elif kind == "on lines":
+        x0, y0, x1, y1 = (float(v) for v in rng.integers(0, 17, 4))
+    everything = all(
+        not occupied[r, c]
+        or _segment_square_distance2(x0, y0, x1, y1, float(c), float(r), c + 1.0, r + 1.0) >= max(radius**2, 1e-300)
+        for r in range(16)
+        for c in range(16)
+    )
+    assert swept_disk_is_free(occupied, x0, y0, x1, y1, radius, 1.0, False) == everything
