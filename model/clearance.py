@@ -107,9 +107,13 @@ def swept_disk_is_free(
         col_lo = max(math.floor((x_lo - radius) / cell) - 1, 0)
         col_hi = min(math.floor((x_hi + radius) / cell) + 1, cols - 1)
         for col in range(col_lo, col_hi + 1):
-            if occupied[row, col] and _segment_square_distance2(
-                x0, y0, x1, y1, col * cell, row * cell, (col + 1) * cell, (row + 1) * cell
-            ) < reach2:
+            if (
+                occupied[row, col]
+                and _segment_square_distance2(
+                    x0, y0, x1, y1, col * cell, row * cell, (col + 1) * cell, (row + 1) * cell
+                )
+                < reach2
+            ):
                 return False
     return True
 
