@@ -20,6 +20,12 @@ if TYPE_CHECKING:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--id", type=int, required=True, help="this agent's id, 0..N-1")
     parser.add_argument("--counts", help="write message counters to this JSON file at exit")
+    parser.add_argument(
+        "--await-logger",
+        action="store_true",
+        help="with --no-coordinator: start the run only once a logger is listening (so its recording has every "
+        "step); the coordinator waits for it otherwise",
+    )
     add_deltas_argument(parser)
     add_process_arguments(parser)
     add_robot_arguments(parser)
@@ -47,8 +53,18 @@ def main(args: argparse.Namespace) -> int:
     scenario = scenario_from_arguments(args)
     if not 0 <= args.id < scenario.agents:
         raise ScenarioError(f"--id: expected an agent id from 0 to {scenario.agents - 1}, got {args.id}")
+    if args.await_logger and not args.no_coordinator:
+        raise ScenarioError("--await-logger: only with --no-coordinator (with a coordinator, it waits for the logger)")
     options = AgentOptions(
-        args.team, args.id, args.clock, args.speed, args.drop_rate, args.counts, args.deltas, args.no_coordinator
+        args.team,
+        args.id,
+        args.clock,
+        args.speed,
+        args.drop_rate,
+        args.counts,
+        args.deltas,
+        args.no_coordinator,
+        args.await_logger,
     )
     ros2 = ros2_options(args, scenario) if args.robot == "ros2" else None
     return run_agent(scenario, options, config_from_arguments(args), stop, ros2)

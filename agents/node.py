@@ -42,6 +42,7 @@ class AgentOptions:
     counts_file: str | None = None
     deltas: str = "event"  # how this agent's deltas travel: "event" or "cells" (protocol.events)
     no_coordinator: bool = False  # a team without one (local planning, realtime): agree and start with the peers
+    await_logger: bool = False  # with no coordinator: start only once a logger listens (its recording has every step)
 
 
 class AgentNode:

@@ -245,7 +245,7 @@ coordinator waits for every hello)."""
 
 def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
     """No coordinator: wait until every agent of the team answers with this agent's scenario and map
-    (ScenarioMismatch at the first that does not). False: stopped, the launcher gone, or PEERS_TIMEOUT
+    (ScenarioMismatch at the first that does not) and, with ``await_logger``, a logger listens. False: stopped, the launcher gone, or PEERS_TIMEOUT
     passed (a teammate that died at its start would otherwise keep the others waiting for ever)."""
     node = bus.node
     mine = digest_of(node.scenario)
@@ -254,17 +254,23 @@ def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
     while not stop.stopped:
         found = peer_digests(bus.session, node.keys, node.limits, timeout=HELLO_PERIOD)
         check_peers(mine, found, node.scenario)
-        if len(found) == node.scenario.agents:
+        logger_ready = not node.options.await_logger or logger_listens(bus)
+        if len(found) == node.scenario.agents and logger_ready:
             return True
         if parent_is_gone(parent):
             return False
         if time.monotonic() > deadline:
             missing = sorted(set(range(node.scenario.agents)) - set(found))
-            log.error(
-                "agent %d: agents %s never answered in %.0f s; giving up", node.options.agent, missing, PEERS_TIMEOUT
-            )
+            never = f"agents {missing}" if missing else "no logger"
+            log.error("agent %d: %s answered in %.0f s; giving up", node.options.agent, never, PEERS_TIMEOUT)
             return False
     return False
+
+
+def logger_listens(bus: Bus) -> bool:
+    """A logger's liveliness token is up: it declares it once it is subscribed and agrees with the team."""
+    replies = bus.session.liveliness().get(bus.node.keys.alive("logger"), timeout=HELLO_PERIOD)
+    return any(reply.ok is not None for reply in replies)
 
 
 def start_without_coordinator(bus: Bus) -> None:

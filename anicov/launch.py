@@ -291,7 +291,8 @@ def start_team(args: argparse.Namespace, agents: int, out_dir: Path, children: l
     command line (a killed coordinator is started again with it).
 
     All children start at once; the coordinator starts the run when every agent has said hello and,
-    when recording, the logger listens (so the recording holds every step).
+    when recording, the logger listens (so the recording holds every step). With no coordinator, the
+    agents wait for the logger themselves (--await-logger).
     """
     logs = out_dir / "logs"
     recording = not args.no_record or args.viewer or args.serve
@@ -317,6 +318,7 @@ def start_team(args: argparse.Namespace, agents: int, out_dir: Path, children: l
             "--deltas",
             args.deltas,
         ]
+        agent_flags += ["--await-logger"] * bool(args.no_coordinator and recording)  # the coordinator's job else
         agent_flags += ros2_agent_flags(args, agent)
         name = f"agent-{agent}"
         children.append(spawn(name, child_command("agent", args, agent_flags, identity=name), logs))

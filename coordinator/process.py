@@ -37,40 +37,43 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
     with open_session(config) as session:
         bus = CoordinatorBus.declare(session, node)
         traffic = TrafficReporter(session, bus.keys.traffic("coordinator"), "coordinator", 0, bus.traffic).start()
-        loss = LossTimer()  # from here, as before: the first step's patience includes the start
-        settle_garbage_collector()
-        load_map_kernels()  # while the agents start, not in step 0
-        load_event_kernel(node.limits.kernel)
-        found = gather_team(bus, options.await_logger, stop, parent)
-        step = 0
-        if found.running:
-            step = resume_running_team(bus, found)
-        elif len(node.positions) < scenario.agents or not found.logger_ready:
-            missing = "" if found.logger_ready else " and no logger appeared"
-            log.error("only %d of %d agents said hello%s; giving up", len(node.positions), scenario.agents, missing)
-            bus.announce(RunControl("abort", 0, reason="agents missing at start"))
+        try:
+            loss = LossTimer()  # from here, as before: the first step's patience includes the start
+            settle_garbage_collector()
+            load_map_kernels()  # while the agents start, not in step 0
+            load_event_kernel(node.limits.kernel)
+            found = gather_team(bus, options.await_logger, stop, parent)
+            step = 0
+            if found.running:
+                step = resume_running_team(bus, found)
+            elif len(node.positions) < scenario.agents or not found.logger_ready:
+                missing = "" if found.logger_ready else " and no logger appeared"
+                log.error("only %d of %d agents said hello%s; giving up", len(node.positions), scenario.agents, missing)
+                bus.announce(RunControl("abort", 0, reason="agents missing at start"))
+                traffic.stop()
+                bus.token.undeclare()
+                return stop.exit_code(EXIT_FAILED)
+            else:
+                node.members = set(range(scenario.agents))
+                log.info("all %d agents present; starting (%s clock)", scenario.agents, options.clock)
+                node.take_snapshot(0.0)
+            stepping = Stepping(bus, options.speed, step, loss=loss)
+            stepping.first_message(resumed=bool(found.running))
+            turn = stepping.lockstep_turn if node.lockstep else stepping.realtime_turn
+            while stepping.outcome is None and not stop.stopped:
+                if parent_is_gone(parent):
+                    stop.set()
+                    break
+                turn()
+                if stepping.outcome is None or node.lockstep:
+                    stepping.status_if_due()
+            done = announce_end(bus, stepping)
+            settle_last_deltas(bus, done)
             traffic.stop()
             bus.token.undeclare()
-            return stop.exit_code(EXIT_FAILED)
-        else:
-            node.members = set(range(scenario.agents))
-            log.info("all %d agents present; starting (%s clock)", scenario.agents, options.clock)
-            node.take_snapshot(0.0)
-        stepping = Stepping(bus, options.speed, step, loss=loss)
-        stepping.first_message(resumed=bool(found.running))
-        turn = stepping.lockstep_turn if node.lockstep else stepping.realtime_turn
-        while stepping.outcome is None and not stop.stopped:
-            if parent_is_gone(parent):
-                stop.set()
-                break
-            turn()
-            if stepping.outcome is None or node.lockstep:
-                stepping.status_if_due()
-        done = announce_end(bus, stepping)
-        settle_last_deltas(bus, done)
-        traffic.stop()
-        bus.token.undeclare()
-        write_outputs(bus, stepping, step if found.running else None, options.out)
+            write_outputs(bus, stepping, step if found.running else None, options.out)
+        finally:
+            traffic.stop()  # idempotent: on an error too, its thread must not outlive the session
     if stepping.outcome is None:
         return stop.exit_code(EXIT_FAILED)
     return EXIT_OK if stepping.outcome[1] else EXIT_INCOMPLETE

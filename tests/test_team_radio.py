@@ -111,9 +111,9 @@ def test_local_planning_finishes_the_run_after_the_coordinator_is_killed(tmp_pat
 
 
 def test_a_team_started_without_a_coordinator_covers_and_ends_with_one_map(tmp_path):
-    """--no-coordinator: the agents check each other's scenario, start when all four agree, plan for
-    themselves, end when their replicas are complete; every replica ends the same map, the logger records
-    the run and leaves when the robots have."""
+    """--no-coordinator: the agents check each other's scenario, start when all four agree and the logger
+    listens, plan for themselves, end when their replicas are complete; every replica ends the same map,
+    the logger records the run from its first step and leaves when the robots have."""
     config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=4, seed=3, planning="local")
     team = unique_team()
     out = tmp_path / "team"
@@ -133,6 +133,8 @@ def test_a_team_started_without_a_coordinator_covers_and_ends_with_one_map(tmp_p
     assert "Traceback" not in logger_log
     recorded = summarise_recording(out / "recording.rrd", load_maps=False)
     assert recorded.agents == [0, 1, 2, 3] and ("agent-0", "bytes_out") in recorded.traffic
+    # The agents waited for the logger (--await-logger), so it has every robot from its first step.
+    assert all(min(steps) == 0 for steps in recorded.positions.values())
     assert (
         "bus per robot" in launched.stdout and json.loads((out / "bandwidth.json").read_text())["agents_counted"] == 4
     )
