@@ -2,7 +2,9 @@
 
 Step by step from 0, the deltas of step s−1 enter the replica (Λ_s), e_D and the map snapshots are
 logged, the states of step s are recorded and, in lockstep on a replanning step, the planner runs on
-Λ_s and the poses of step s, so its memory of blobs is the one the lost coordinator had. The run
+Λ_s and the poses of step s, so its memory of blobs is the one the lost coordinator had. In realtime
+the plans ran on the wall clock and are not replayed, except the anicov controller's first, which cut
+its routes from the starting poses: each robot is then put back on its route (LanePlanner.resume). The run
 resumes at the latest step every member has published. In lockstep that step is still open (its
 deltas go into the next go), so a run that lost its coordinator still equals the engine. Agents gone
 before the restart left no history: their coverage is adopted from a member's snapshot.
@@ -11,6 +13,7 @@ before the restart left no history: their coverage is adopted from a member's sn
 from __future__ import annotations
 
 from coordinator.node import Coordinator
+from model.lane_planner import LanePlanner
 from protocol.inbox import Received
 from protocol.messages import AgentState, MapDelta, Snapshot
 
@@ -56,6 +59,15 @@ def rebuild(node: Coordinator, messages: HistoryMessages, members: set[int], sna
             node.log.events.append(f"coverage of agents {sorted(gone)} taken from a member's snapshot")
         if node.lockstep:
             node.open_step = resume
+        elif isinstance(node.planner, LanePlanner) and node.planner.routes:
+            # Realtime plans are not replayed (they ran on the wall clock), but the anicov controller's
+            # routes were cut once, at the first plan: cut them again and put each robot on its own.
+            positions = [node.positions[agent] for agent in sorted(publishing)]
+            node.planner.resume(node.replica.map.lack_of_coverage(), positions, sorted(publishing))
+            on_routes = [agent for agent in sorted(publishing) if not node.planner.routes[agent].done()]
+            node.log.events.append(
+                f"anicov routes cut again; agents {on_routes} resume on theirs, the others take passes"
+            )
         # What lies beyond: the open step's deltas (for the next go) and any later ones.
         for message in messages:
             if isinstance(message, MapDelta) and message.seq >= resume and message.agent in members:
@@ -81,6 +93,8 @@ def replay(
             node.positions[state.agent] = (state.pose[0], state.pose[1])
         if node.lockstep and step % node.scenario.plan_steps == 0:
             node.plan(step)
+        elif step == 0 and isinstance(node.planner, LanePlanner):
+            node.plan(step)  # realtime: the routes as the first plan cut them, from the starting poses
         for state in states.get(step, []):
             node.latest_state_step[state.agent] = step
             node.positions[state.agent] = (state.next_pose[0], state.next_pose[1])

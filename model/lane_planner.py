@@ -128,6 +128,21 @@ class Route:
     def done(self) -> bool:
         return self.progress >= self.length - 1e-6
 
+    def nearest(self, position: np.ndarray) -> tuple[float, float]:
+        """(distance, arc length) of the route's point nearest to ``position``, the first on a tie."""
+        if len(self.points) == 1:
+            return float(np.linalg.norm(self.points[0] - position)), 0.0
+        best_gap, best_at = math.inf, 0.0
+        for k in range(len(self.points) - 1):
+            a, b = self.points[k], self.points[k + 1]
+            d = b - a
+            span2 = float(d @ d)
+            t = 0.0 if span2 == 0.0 else float(np.clip((position - a) @ d / span2, 0.0, 1.0))
+            gap = float(np.linalg.norm(a + t * d - position))
+            if gap < best_gap - 1e-9:
+                best_gap, best_at = gap, float(self.along[k] + t * (self.along[k + 1] - self.along[k]))
+        return best_gap, best_at
+
 
 def spiral_path(scenario: Scenario, spacing: float) -> np.ndarray:
     """The one-robot sweep: a rectangular spiral inward, as a polyline (K, 2). Its outer ring lies d100
@@ -297,6 +312,31 @@ class LanePlanner:
             [self.routes[agent].point_at(self.routes[agent].progress + LOOKAHEAD) for agent in ids], dtype=np.float64
         )
         return targets.reshape(-1, 2)
+
+    def resume(self, lack: np.ndarray, positions: np.ndarray, members: list[int]) -> None:
+        """A planner rebuilt after its coordinator was lost in realtime, its routes cut again at a first
+        plan on the robots' starting positions (as the lost one cut them): each robot is put at the nearest
+        point of its route, and its route is done if it stands farther than half a spacing from it (it was
+        on a pass) or nothing uncovered lies within half a spacing of what is left of it (it had flown
+        it), so that the next plan gives it a pass instead of flying covered ground again."""
+        positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
+        for index, agent in enumerate(members):
+            route = self.routes.get(agent)
+            if route is None or route.cleanup:
+                continue
+            gap, at = route.nearest(positions[index])
+            route.progress = at
+            if gap > self.spacing / 2.0 or not self._left_to_cover(lack, route):
+                route.progress = route.length
+
+    def _left_to_cover(self, lack: np.ndarray, route: Route) -> bool:
+        """Whether an uncovered cell lies within half a spacing of the route from its progress on."""
+        strip = np.zeros(lack.shape, dtype=np.uint8)
+        ahead = route.points[route.along > route.progress]
+        line = np.vstack([route.point_at(route.progress), ahead]) / self.scenario.cell
+        width = max(1, round(self.spacing / self.scenario.cell))
+        cv2.polylines(strip, [np.round(line).astype(np.int32)], False, 1, thickness=width)
+        return bool((lack[strip.astype(bool)] > 0.0).any())
 
     def _all(self, ids: list[int], positions: np.ndarray) -> np.ndarray:
         """Every robot's position at the first plan (a robot not among the members: the domain's centre)."""

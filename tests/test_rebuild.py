@@ -3,11 +3,14 @@ coordinator that lived the run would be."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from coordinator.node import Coordinator, CoordinatorOptions
 from coordinator.rebuild import by_step, rebuild, resume_step
 from model.coverage_map import CoverageMap
+from model.lane_planner import LanePlanner, best_lane_spacing
+from model.parameters import initial_poses
 from tests.test_coordinator_node import SCENARIO, team_steps
 
 
@@ -63,3 +66,19 @@ def test_members_without_a_history_are_left_out_and_no_history_at_all_is_an_erro
     assert resume_step(states, {0}) == (2, {0})
     with pytest.raises(RuntimeError, match="no history of agents"):
         resume_step({}, {0, 1})
+
+
+def test_a_realtime_anicov_coordinator_cuts_its_routes_again_and_puts_each_robot_back():
+    """Realtime plans are not replayed, but the anicov controller's routes were cut at the first plan,
+    from the starting poses: the rebuilt planner holds the same routes, each robot located on its own."""
+    scenario = SCENARIO.with_overrides(controller="anicov")
+    steps = team_steps(scenario, 6)
+    node = Coordinator(scenario, CoordinatorOptions("t", clock="realtime"))
+    rebuild(node, history(steps, {0: 5, 1: 5}), members={0, 1})
+    fresh = LanePlanner(scenario)
+    fresh.plan(np.ones(scenario.grid_shape), initial_poses(scenario)[:, :2])
+    for agent in (0, 1):
+        route = node.planner.routes[agent]
+        assert np.array_equal(route.points, fresh.routes[agent].points)
+        gap, at = route.nearest(np.array(node.positions[agent]))
+        assert route.done() or (gap <= best_lane_spacing(scenario) / 2.0 and route.progress == at)
