@@ -28,6 +28,15 @@ from numba import njit
 def segment_crosses_occupied(occupied: np.ndarray, x0: float, y0: float, x1: float, y1: float, cell: float) -> bool:
     """Whether the segment (x0, y0) → (x1, y1) passes through an occupied cell other than its two end cells
     (Amanatides–Woo traversal; cells outside the grid count as free here)."""
+    return first_occupied_crossed(occupied, x0, y0, x1, y1, cell)[0] >= 0
+
+
+@njit(cache=True)
+def first_occupied_crossed(
+    occupied: np.ndarray, x0: float, y0: float, x1: float, y1: float, cell: float
+) -> tuple[int, int]:
+    """(row, col) of the first occupied cell the traversal of :func:`segment_crosses_occupied` meets,
+    (−1, −1) if none."""
     rows, cols = occupied.shape
     col, row = math.floor(x0 / cell), math.floor(y0 / cell)
     end_col, end_row = math.floor(x1 / cell), math.floor(y1 / cell)
@@ -51,9 +60,9 @@ def segment_crosses_occupied(occupied: np.ndarray, x0: float, y0: float, x1: flo
         if t_max_x == t_max_y:
             # Exactly through a grid corner: both cells beside it count, so a diagonal wall does not leak.
             if _occupied_at(occupied, row, col + step_col, rows, cols, end_row, end_col):
-                return True
+                return row, col + step_col
             if _occupied_at(occupied, row + step_row, col, rows, cols, end_row, end_col):
-                return True
+                return row + step_row, col
             col += step_col
             row += step_row
             t_max_x += t_delta_x
@@ -65,8 +74,8 @@ def segment_crosses_occupied(occupied: np.ndarray, x0: float, y0: float, x1: flo
             row += step_row
             t_max_y += t_delta_y
         if _occupied_at(occupied, row, col, rows, cols, end_row, end_col):
-            return True
-    return False
+            return row, col
+    return -1, -1
 
 
 @njit(cache=True)

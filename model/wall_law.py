@@ -28,7 +28,7 @@ from numba import njit
 from model.control import global_law_around_walls
 from model.geodesic import descent_waypoint
 from model.ground import Ground
-from model.visibility import line_of_sight
+from model.visibility import first_occupied_crossed, hidden_by_teammates, line_of_sight
 
 
 @njit(cache=True)
@@ -103,16 +103,92 @@ def uncovered_to_look_at(
         return centre_x, centre_y
     span = math.ceil(sensing_range / cell)
     centre_row, centre_col = math.floor(y / cell), math.floor(x / cell)
-    best, best_x, best_y = sensing_range, math.nan, math.nan
-    for r in range(max(centre_row - span, 0), min(centre_row + span + 1, rows)):
-        for c in range(max(centre_col - span, 0), min(centre_col + span + 1, cols)):
-            if coverage[r, c] >= target_ticks or occupied[r, c]:
-                continue
-            cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
-            gap = math.hypot(cx - x, cy - y)
-            if gap < best and _in_clear_sight(ground, teammates, x, y, cx, cy, cell):
-                best, best_x, best_y = gap, cx, cy
+    hiding = teammates if ground.occlusion else teammates[:0]
+    # Ring by ring outward (Chebyshev rings round the robot's cell), until no cell of the next ring can
+    # be nearer than the best found; of equal gaps the first in row-major order wins, as in a scan of the
+    # whole square keeping the strictly nearer. Each wall square a line was found to cross hides, for sure,
+    # every cell beyond its farthest corner on the bearings strictly inside its span (their segments cross
+    # its inside): kept per bearing bin, so a robot among walls tests a few lines, not every cell within R.
+    beyond = np.full(LOOK_BINS, np.inf)
+    best, best_index, best_x, best_y = sensing_range, rows * cols, math.nan, math.nan
+    for ring in range(span + 1):
+        if (ring - 0.5) * cell > best:
+            break
+        for r in range(max(centre_row - ring, 0), min(centre_row + ring + 1, rows)):
+            edge_row = r == centre_row - ring or r == centre_row + ring
+            step = 1 if edge_row else 2 * ring
+            for c in range(centre_col - ring, centre_col + ring + 1, max(step, 1)):
+                if c < 0 or c >= cols or coverage[r, c] >= target_ticks or occupied[r, c]:
+                    continue
+                cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
+                gap = math.hypot(cx - x, cy - y)
+                index = r * cols + c
+                if gap > best or (gap == best and index > best_index) or gap >= sensing_range:
+                    continue
+                if gap > 0.0 and gap * gap > beyond[_look_bin(cx - x, cy - y)]:
+                    continue  # (a robot on the cell's centre sees it: no bearing, nothing between)
+                wall_row, wall_col = first_occupied_crossed(occupied, x, y, cx, cy, cell)
+                if wall_row >= 0:
+                    _shadow_behind(beyond, wall_col * cell - x, wall_row * cell - y, cell)
+                    continue
+                if not hidden_by_teammates(hiding, ground.radius, x, y, cx, cy):
+                    best, best_index, best_x, best_y = gap, index, cx, cy
     return best_x, best_y
+
+
+LOOK_BINS = 720
+"""Bearing bins of the look-at search's shadows (by the diamond angle: 180 a quadrant)."""
+ANGLE_SLACK = 1e-9
+"""How far inside a square's span, in radians, a bearing must lie to be called inside: far more than the
+rounding of an arctangent, so a line grazing the square's corner is never taken for one crossing it."""
+
+
+@njit(cache=True)
+def _diamond(dx: float, dy: float) -> float:
+    """The diamond angle of the direction (dx, dy) ≠ (0, 0): in [0, 4), increasing with the bearing from +x
+    anticlockwise like the angle itself, and a division where the angle needs an arctangent."""
+    if dy >= 0.0:
+        return dy / (dx + dy) if dx >= 0.0 else 1.0 - dx / (dy - dx)
+    return 2.0 - dy / (-dx - dy) if dx < 0.0 else 3.0 + dx / (dx - dy)
+
+
+@njit(cache=True)
+def _look_bin(dx: float, dy: float) -> int:
+    """The bearing bin of the direction (dx, dy)."""
+    return min(math.floor(_diamond(dx, dy) * (LOOK_BINS / 4.0)), LOOK_BINS - 1)
+
+
+@njit(cache=True)
+def _shadow_behind(beyond: np.ndarray, left: float, bottom: float, cell: float) -> None:
+    """Mark the bins wholly inside the angular span of the square with lower-left corner (left, bottom)
+    relative to the robot with the squared distance of its farthest corner."""
+    gap_x, gap_y = max(left, 0.0, -left - cell), max(bottom, 0.0, -bottom - cell)
+    if gap_x * gap_x + gap_y * gap_y < 1e-12:
+        return  # the robot on its edge: no span to speak of
+    centre = math.atan2(bottom + 0.5 * cell, left + 0.5 * cell)
+    low, high, farthest2 = math.inf, -math.inf, 0.0
+    for corner_x, corner_y in (
+        (left, bottom),
+        (left + cell, bottom),
+        (left, bottom + cell),
+        (left + cell, bottom + cell),
+    ):
+        offset = math.atan2(corner_y, corner_x) - centre
+        offset = math.atan2(math.sin(offset), math.cos(offset))  # the square does not hold the robot: |offset| < π/2
+        low, high = min(low, offset), max(high, offset)
+        farthest2 = max(farthest2, corner_x * corner_x + corner_y * corner_y)
+    inner_low, inner_high = centre + low + ANGLE_SLACK, centre + high - ANGLE_SLACK
+    if inner_low >= inner_high:
+        return
+    start = _diamond(math.cos(inner_low), math.sin(inner_low))
+    end = _diamond(math.cos(inner_high), math.sin(inner_high))
+    if end < start:
+        end += 4.0  # across the +x axis
+    first = math.floor(start * (LOOK_BINS / 4.0)) + 1
+    last = math.floor(end * (LOOK_BINS / 4.0)) - 1
+    for k in range(first, last + 1):
+        b = k % LOOK_BINS
+        beyond[b] = min(beyond[b], farthest2)
 
 
 @njit(cache=True)

@@ -6,8 +6,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from model.ground import Ground
+from model.visibility import line_of_sight
 from model.wall_law import global_law_among_walls, uncovered_to_look_at
 
 TARGET = 100
@@ -56,3 +59,61 @@ def test_with_nothing_left_in_sight_the_robot_goes_nearer_instead_of_waiting():
         np.zeros((0, 2)),
     )  # fmt: skip
     assert u_glo == 0.0 and math.isclose(theta, math.atan2(12.5 - y, 10.5 - x))  # stops and looks
+
+
+def nearest_in_sight_by_scan(coverage, ground, teammates, x, y, objective_x, objective_y, reach, cell):
+    """The rule of uncovered_to_look_at, cell by cell with the exact test and nothing pruned."""
+    hiding = teammates if ground.occlusion else teammates[:0]
+    rows, cols = coverage.shape
+    row = min(max(math.floor(objective_y / cell), 0), rows - 1)
+    col = min(max(math.floor(objective_x / cell), 0), cols - 1)
+    centre = ((col + 0.5) * cell, (row + 0.5) * cell)
+    if coverage[row, col] < TARGET and line_of_sight(ground.occupied, x, y, *centre, cell, hiding, ground.radius):
+        return centre
+    best, found = reach, (math.nan, math.nan)
+    for r in range(rows):
+        for c in range(cols):
+            if coverage[r, c] >= TARGET or ground.occupied[r, c]:
+                continue
+            point = ((c + 0.5) * cell, (r + 0.5) * cell)
+            gap = math.hypot(point[0] - x, point[1] - y)
+            if gap < best and line_of_sight(ground.occupied, x, y, *point, cell, hiding, ground.radius):
+                best, found = gap, point
+    return found
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.05, 0.3, 1.0]), st.booleans(), st.booleans())
+def test_the_look_at_search_finds_what_a_scan_of_every_cell_finds(seed, uncovered_share, occlusion, on_lines):
+    """Walls, teammates close round the robot, a covered disk round it (what is left lies behind walls):
+    the search, which skips cells behind a wall it has already met, answers as the exact test on every
+    cell. Robots on cell edges and corners too, where lines pass through grid corners."""
+    rng = np.random.default_rng(seed)
+    occupied = rng.random((40, 40)) < 0.25
+    x, y = rng.uniform(12.0, 28.0, 2)
+    if on_lines:
+        x, y = math.floor(x) + 0.5 * rng.integers(0, 2), math.floor(y) + 0.5 * rng.integers(0, 2)
+    occupied[int(y), int(x)] = False
+    coverage = np.where(rng.random((40, 40)) < uncovered_share, 0, TARGET).astype(np.int64)
+    covered_round = np.hypot(np.arange(40)[None, :] + 0.5 - x, np.arange(40)[:, None] + 0.5 - y) < rng.uniform(
+        3.0, 16.0
+    )
+    coverage[covered_round] = TARGET
+    angles = rng.uniform(-np.pi, np.pi, 3)
+    teammates = np.array([x, y]) + rng.uniform(1.1, 5.0, 3)[:, None] * np.stack([np.cos(angles), np.sin(angles)], 1)
+    ground = ground_of(occupied, 0.5, occlusion)
+    objective = rng.uniform(0.0, 40.0, 2)
+    found = uncovered_to_look_at(coverage, TARGET, ground, teammates, x, y, *objective, 20.0, 1.0)
+    expected = nearest_in_sight_by_scan(coverage, ground, teammates, x, y, *objective, 20.0, 1.0)
+    assert np.array_equal(found, expected, equal_nan=True)
+
+
+def test_a_robot_on_the_centre_of_the_last_uncovered_cell_looks_at_it():
+    occupied = np.zeros((20, 20), dtype=bool)
+    occupied[0, 0] = True
+    coverage = one_uncovered_cell(10, 10)
+    ground = ground_of(occupied)
+    assert uncovered_to_look_at(coverage, TARGET, ground, np.zeros((0, 2)), 10.5, 10.5, 3.5, 3.5, 20.0, 1.0) == (
+        10.5,
+        10.5,
+    )
