@@ -153,7 +153,13 @@ class Coordinator:
         return closed
 
     def offer(self, delta: MapDelta) -> None:
-        """Apply a delta; in lockstep keep the open step's for the next go."""
+        """Apply a delta; in lockstep keep the open step's for the next go. In lockstep a delta of a step
+        already closed can only be a departed agent's, come late (a step closes when every member's is
+        in): no go can carry it any more, so it is dropped, not applied, or this replica alone would hold it."""
+        if self.open_step is not None and delta.seq < self.open_step and not self.replica.has(delta.agent, delta.seq):
+            self.log.events.append(f"a late delta of agent {delta.agent} for closed step {delta.seq} dropped")
+            log.warning("agent %d's delta for step %d came after the step closed; dropped", delta.agent, delta.seq)
+            return
         if self.replica.apply(delta) and delta.seq == self.open_step:
             self.open_deltas[delta.agent] = delta
 
@@ -166,7 +172,9 @@ class Coordinator:
     def go(self, step: int, deltas: list[MapDelta], final: bool = False) -> StepGo:
         """Lockstep: step ``step`` may start, with every member's previous delta and state (the closed
         step's). The final go only completes every replica: no objectives."""
-        kept = tuple(sorted((delta for delta in deltas if delta.agent in self.members), key=lambda d: d.agent))
+        # Every delta of the closed step, a member's or not: each is in this replica already (an agent that
+        # left after its delta came in still covered those cells), so every replica must have it too.
+        kept = tuple(sorted(deltas, key=lambda d: d.agent))
         states = tuple(self.closed_states[agent] for agent in sorted(self.closed_states) if agent in self.members)
         objectives = self.plan_if_due(step) if self.members and not final else None
         return StepGo(step, tuple(sorted(self.members)), kept, objectives, states)

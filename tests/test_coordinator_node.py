@@ -129,3 +129,33 @@ def test_each_agents_last_row_is_where_its_last_heard_step_took_it_so_rows_follo
     assert tuple(trace[1, 1, :3]) == (2.0, 1.0, 0.0) and tuple(trace[1, 1, 3:5]) == (0.0, 0.0)
     assert np.isnan(trace[2:, 1]).all()
     assert tuple(trace[3, 0, :3]) == (4.0, 1.0, 0.0)  # its state of step 3 started there, as step 2 ended
+
+
+def test_a_delta_of_an_agent_that_left_before_its_step_closed_still_goes_to_everyone():
+    """Agent 1's delta of step 0 is in the coordinator's map when agent 1 is found dead (SIGKILL under
+    load: its teammates' deltas were late); step 0 closes on agent 0 alone, and the go must carry agent 1's
+    delta too, or the coordinator's map alone would hold it."""
+    node = started_coordinator()
+    steps = team_steps(SCENARIO, 1)
+    node.handle(Received("", steps[0][1]))
+    node.handle(Membership(1, alive=False))
+    node.handle(Received("", steps[0][0]))
+    assert node.step_complete(0)
+    go = node.go(1, node.open_next_step())
+    assert [delta.agent for delta in go.deltas] == [0, 1] and go.members == (0,)
+    assert [state.agent for state in go.states] == [0]
+
+
+def test_a_late_delta_of_a_closed_step_is_dropped_not_applied():
+    """Step 0 closed without agent 1 (it left); its delta of step 0 coming now cannot go out in any go,
+    so the coordinator must not apply it either."""
+    node = started_coordinator()
+    steps = team_steps(SCENARIO, 1)
+    node.handle(Membership(1, alive=False))
+    node.handle(Received("", steps[0][0]))
+    node.go(1, node.open_next_step())
+    before = node.replica.map.coverage.copy()
+    node.handle(Received("", steps[0][1]))
+    assert not node.replica.has(1, 0)
+    assert np.array_equal(node.replica.map.coverage, before)
+    assert any("late delta of agent 1 for closed step 0" in event for event in node.log.events)
