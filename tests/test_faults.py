@@ -67,9 +67,7 @@ def log_time(line: str) -> float:
 def test_team_survives_an_agent_killed_mid_run(tmp_path, clock):
     team = unique_team()
     out = tmp_path / "run"
-    # Realtime runs the anicov controller: its routes, cut once at the first plan, must be cut again and
-    # each robot put back on its own (the paper's law keeps nothing a realtime rebuild must restore).
-    extra = ["--speed", "40", "--controller", "anicov"] if clock == "realtime" else []
+    extra = ["--speed", "40"] if clock == "realtime" else []
     with launched_team("--n", "4", "--seed", "0", "--clock", clock, *extra, "--out", str(out), team=team) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)  # well into the run
@@ -433,10 +431,15 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     An agent killed before the coordinator left no history: its coverage comes from a member's replica."""
     team = unique_team()
     out = tmp_path / "run"
-    # Realtime runs the anicov controller: its routes, cut once at the first plan, must be cut again and
-    # each robot put back on its own (the paper's law keeps nothing a realtime rebuild must restore).
-    extra = ["--speed", "40", "--controller", "anicov"] if clock == "realtime" else []
-    with launched_team("--n", "4", "--seed", "0", "--clock", clock, *extra, "--out", str(out), team=team) as process:
+    # Realtime runs the anicov controller, on a smaller square: its routes, cut once at the first plan,
+    # must be cut again and each robot put back on its own (the paper's law keeps nothing a realtime
+    # rebuild must restore).
+    if clock == "realtime":
+        anicov_square = write_scenario(tmp_path / "s.toml", domain=[60.0, 60.0], agents=4, seed=0, controller="anicov")
+        extra = ["--config", str(anicov_square), "--speed", "40"]
+    else:
+        extra = ["--n", "4", "--seed", "0"]
+    with launched_team("--clock", clock, *extra, "--out", str(out), team=team) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)  # well into the run
         if agent_dies_first:

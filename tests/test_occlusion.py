@@ -43,7 +43,7 @@ def test_the_pruned_wedge_hides_exactly_what_the_rule_hides(seed, theta, radius)
         assert seen[i, j] == (everything[i, j] if visible else 0)
 
 
-@settings(max_examples=300)
+@settings(max_examples=150)
 @given(
     st.integers(0, 2**32 - 1),
     st.integers(40, 120),
@@ -69,7 +69,7 @@ def test_pruning_is_exact_on_grid_lines_corners_and_diagonals(seed, quarter_x, q
         assert seen[i, j] == (everything[i, j] if visible else 0)
 
 
-@settings(max_examples=300)
+@settings(max_examples=150)
 @given(st.integers(0, 2**32 - 1), st.floats(-math.pi, math.pi))
 def test_teammates_beside_and_behind_hide_exactly_what_the_rule_hides(seed, theta):
     """No wall: only teammates' disks prune, close round the robot, in front, beside and behind it."""

@@ -82,7 +82,7 @@ def nearest_in_sight_by_scan(coverage, ground, teammates, x, y, objective_x, obj
     return found
 
 
-@settings(max_examples=300)
+@settings(max_examples=150)
 @given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.05, 0.3, 1.0]), st.booleans(), st.booleans())
 def test_the_look_at_search_finds_what_a_scan_of_every_cell_finds(seed, uncovered_share, occlusion, on_lines):
     """Walls, teammates close round the robot, a covered disk round it (what is left lies behind walls):
