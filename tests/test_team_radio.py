@@ -92,7 +92,7 @@ def test_local_planning_finishes_the_run_after_the_coordinator_is_killed(tmp_pat
     team = unique_team()
     out = tmp_path / "team"
     with launched_team(
-        "--config", str(config), "--out", str(out), "--clock", "realtime", "--speed", "10",
+        "--config", str(config), "--out", str(out), "--clock", "realtime", "--speed", "20",
         "--coordinator-restarts", "0", team=team,
     ) as process:  # fmt: skip
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
