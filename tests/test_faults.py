@@ -68,7 +68,8 @@ def test_team_survives_an_agent_killed_mid_run(tmp_path, clock):
     team = unique_team()
     out = tmp_path / "run"
     extra = ["--speed", "40"] if clock == "realtime" else []
-    with launched_team("--n", "4", "--seed", "0", "--clock", clock, *extra, "--out", str(out), team=team) as process:
+    square = write_scenario(tmp_path / "s.toml", domain=[70.0, 70.0], agents=4, seed=0)  # half the paper's area
+    with launched_team("--config", str(square), "--clock", clock, *extra, "--out", str(out), team=team) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)  # well into the run
         killed_at = time.time()
@@ -439,8 +440,9 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     if clock == "realtime":
         anicov_square = write_scenario(tmp_path / "s.toml", domain=[60.0, 60.0], agents=4, seed=0, controller="anicov")
         extra = ["--config", str(anicov_square), "--speed", "40"]
-    else:
-        extra = ["--n", "4", "--seed", "0"]
+    else:  # half the paper's area: the run still lasts well past the kill
+        square = write_scenario(tmp_path / "s.toml", domain=[70.0, 70.0], agents=4, seed=0)
+        extra = ["--config", str(square)]
     with launched_team("--clock", clock, *extra, "--out", str(out), team=team) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)  # well into the run
@@ -467,7 +469,7 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     assert 0 < counts["resumed_at"] < summary["steps"]  # it really died mid-run
     assert_every_replica_holds_every_published_delta_once(out, agents=4)
     if clock == "lockstep":
-        engine = anicov("run", "--n", "4", "--seed", "0", "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+        engine = anicov("run", "--config", str(square), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
         assert engine.returncode == 0
         for name in ("trajectory.csv", "summary.json"):
             assert (tmp_path / "engine" / name).read_bytes() == (out / name).read_bytes(), name
