@@ -43,7 +43,7 @@ from protocol.agreement import (
 )
 from protocol.messages import AgentState, AgentStep, MapDelta, encode
 from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
-from protocol.session import RouterUnreachable, open_session, team_publisher, zenoh_config
+from protocol.session import RouterUnreachable, logger_listens, open_session, team_publisher, zenoh_config
 from protocol.sync import SYNC_PERIOD, SyncServer, sync_with
 from protocol.traffic import TrafficReporter
 from runtime.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
@@ -254,7 +254,9 @@ def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
     while not stop.stopped:
         found = peer_digests(bus.session, node.keys, node.limits, timeout=HELLO_PERIOD)
         check_peers(mine, found, node.scenario)
-        logger_ready = not node.options.await_logger or logger_listens(bus)
+        logger_ready = not node.options.await_logger or logger_listens(
+            bus.session, node.keys.alive("logger"), timeout=HELLO_PERIOD
+        )
         if len(found) == node.scenario.agents and logger_ready:
             return True
         if parent_is_gone(parent):
@@ -265,12 +267,6 @@ def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
             log.error("agent %d: %s answered in %.0f s; giving up", node.options.agent, never, PEERS_TIMEOUT)
             return False
     return False
-
-
-def logger_listens(bus: Bus) -> bool:
-    """A logger's liveliness token is up: it declares it once it is subscribed and agrees with the team."""
-    replies = bus.session.liveliness().get(bus.node.keys.alive("logger"), timeout=HELLO_PERIOD)
-    return any(reply.ok is not None for reply in replies)
 
 
 def start_without_coordinator(bus: Bus) -> None:

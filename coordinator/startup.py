@@ -20,6 +20,7 @@ from protocol.inbox import Membership, Received
 from protocol.keys import TeamKeys, agent_of_key
 from protocol.messages import AgentState, AgentStep, Limits, Snapshot
 from protocol.recovery import fetch, fetch_snapshot
+from protocol.session import logger_listens
 from runtime.lifecycle import StopFlag, parent_is_gone
 
 log = logging.getLogger("anicov.coordinator")
@@ -56,9 +57,7 @@ def gather_team(bus: CoordinatorBus, await_logger: bool, stop: StopFlag, parent:
         len(node.positions) < node.scenario.agents or not found.logger_ready
     ):
         if not found.logger_ready:
-            found.logger_ready = any(
-                r.ok is not None for r in session.liveliness().get(keys.alive("logger"), timeout=0.5)
-            )
+            found.logger_ready = logger_listens(session, keys.alive("logger"), timeout=0.5)
         if time.monotonic() >= next_look:  # lockstep agents that lost their coordinator wait in silence
             fetch(session, keys.all_histories, node.inbox, first=0, last=0, timeout=0.5)
             next_look = time.monotonic() + 0.5

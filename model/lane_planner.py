@@ -115,11 +115,7 @@ class Route:
             start, end = self.along[k], self.along[k + 1]
             if end < self.progress or start > reach:
                 continue
-            a, b = self.points[k], self.points[k + 1]
-            d = b - a
-            span2 = float(d @ d)
-            t = 0.0 if span2 == 0.0 else float(np.clip((position - a) @ d / span2, 0.0, 1.0))
-            at = min(max(start + t * (end - start), self.progress), reach)
+            at = min(max(self._foot(k, position), self.progress), reach)
             gap = float(np.linalg.norm(self.point_at(at) - position))
             if gap < best_distance - 1e-9:
                 best, best_distance = at, gap
@@ -134,14 +130,26 @@ class Route:
             return float(np.linalg.norm(self.points[0] - position)), 0.0
         best_gap, best_at = math.inf, 0.0
         for k in range(len(self.points) - 1):
-            a, b = self.points[k], self.points[k + 1]
-            d = b - a
-            span2 = float(d @ d)
-            t = 0.0 if span2 == 0.0 else float(np.clip((position - a) @ d / span2, 0.0, 1.0))
-            gap = float(np.linalg.norm(a + t * d - position))
+            at = self._foot(k, position)
+            gap = float(np.linalg.norm(self.point_at(at) - position))
             if gap < best_gap - 1e-9:
-                best_gap, best_at = gap, float(self.along[k] + t * (self.along[k + 1] - self.along[k]))
+                best_gap, best_at = gap, at
         return best_gap, best_at
+
+    def _foot(self, k: int, position: np.ndarray) -> float:
+        """Arc length of the point of segment k nearest to ``position``."""
+        a, b = self.points[k], self.points[k + 1]
+        d = b - a
+        span2 = float(d @ d)
+        t = 0.0 if span2 == 0.0 else float(np.clip((position - a) @ d / span2, 0.0, 1.0))
+        return float(self.along[k] + t * (self.along[k + 1] - self.along[k]))
+
+    def draw_ahead(self, canvas: np.ndarray, cell: float, width: int) -> None:
+        """Draw what is left of the route (from its progress on) into ``canvas`` (uint8 grid), ``width``
+        cells wide."""
+        ahead = self.points[self.along > self.progress]
+        line = np.vstack([self.point_at(self.progress), ahead]) / cell
+        cv2.polylines(canvas, [np.round(line).astype(np.int32)], False, 1, thickness=width)
 
 
 def spiral_path(scenario: Scenario, spacing: float) -> np.ndarray:
@@ -332,10 +340,7 @@ class LanePlanner:
     def _left_to_cover(self, lack: np.ndarray, route: Route) -> bool:
         """Whether an uncovered cell lies within half a spacing of the route from its progress on."""
         strip = np.zeros(lack.shape, dtype=np.uint8)
-        ahead = route.points[route.along > route.progress]
-        line = np.vstack([route.point_at(route.progress), ahead]) / self.scenario.cell
-        width = max(1, round(self.spacing / self.scenario.cell))
-        cv2.polylines(strip, [np.round(line).astype(np.int32)], False, 1, thickness=width)
+        route.draw_ahead(strip, self.scenario.cell, max(1, round(self.spacing / self.scenario.cell)))
         return bool((lack[strip.astype(bool)] > 0.0).any())
 
     def _all(self, ids: list[int], positions: np.ndarray) -> np.ndarray:
@@ -374,9 +379,7 @@ class LanePlanner:
             route = self.routes[agent]
             if route.cleanup or route.done():
                 continue
-            ahead = route.points[route.along > route.progress]
-            line = np.vstack([route.point_at(route.progress), ahead]) / cell
-            cv2.polylines(claimed, [np.round(line).astype(np.int32)], False, 1, thickness=width)
+            route.draw_ahead(claimed, cell, width)
         return np.where(claimed.astype(bool), 0.0, lack)
 
     def labels(self) -> np.ndarray | None:

@@ -71,3 +71,9 @@ def team_publisher(session: zenoh.Session, key: str) -> zenoh.Publisher:
 def config_from_arguments(args: argparse.Namespace) -> zenoh.Config:
     """The config a team process's flags ask for (runtime.arguments.add_process_arguments)."""
     return zenoh_config(args.mode, connect=args.connect, listen=args.listen, config_file=args.zenoh_config)
+
+
+def logger_listens(session: zenoh.Session, alive_key: str, timeout: float) -> bool:
+    """A logger's liveliness token (``alive_key``: TeamKeys.alive("logger")) is up: it declares it once it
+    is subscribed and agrees with the team, so a run started after this has all of it recorded."""
+    return any(reply.ok is not None for reply in session.liveliness().get(alive_key, timeout=timeout))
