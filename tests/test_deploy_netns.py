@@ -70,7 +70,7 @@ def in_namespace(namespace: str, *args: str) -> list[str]:
 def test_team_across_two_network_namespaces_equals_engine(tmp_path, two_hosts):
     router_ns, robot_ns = two_hosts
     config = write_scenario(tmp_path / "s.toml", domain=[30.0, 30.0], agents=2, seed=5)
-    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet")
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
     assert engine.returncode == 0, engine.stderr
     endpoint = f"tcp/{ROUTER_ADDRESS}:7447"
     environment = os.environ | {"PYTHONPATH": str(ROOT)}

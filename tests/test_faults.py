@@ -400,7 +400,8 @@ def test_a_dead_agents_lost_deltas_come_from_its_teammates_relays(tmp_path):
     with the same map, holding every delta of agent 2 that any replica received."""
     team = unique_team()
     out = tmp_path / "run"
-    with launched_team(*REALTIME_WITH_LOSS, "--out", str(out), team=team) as process:
+    square = write_scenario(tmp_path / "s.toml", domain=[70.0, 70.0], agents=4, seed=0)  # half the paper's area
+    with launched_team(*REALTIME_WITH_LOSS, "--config", str(square), "--out", str(out), team=team) as process:
         assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
         time.sleep(2.0)  # well into the run
         os.kill(agent_pid(team, 2), signal.SIGKILL)

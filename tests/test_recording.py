@@ -123,7 +123,8 @@ def test_serve_hosts_a_web_viewer_and_a_grpc_server_while_the_file_is_still_writ
         except OSError:
             return b""
 
-    with launched_team("--n", "4", "--seed", "0", "--out", str(out), *serving) as process:
+    square = write_scenario(tmp_path / "s.toml", domain=[60.0, 60.0], agents=4, seed=0)
+    with launched_team("--config", str(square), "--out", str(out), *serving) as process:
         assert wait_for(lambda: page() != b"", timeout=120)
         assert b"<html" in page().lower()
         with socket.create_connection(("127.0.0.1", grpc_port), timeout=2):

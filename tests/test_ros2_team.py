@@ -26,9 +26,15 @@ SLACK = 0.3  # scheduling on a loaded 2-core machine: what a stated time may be 
 
 
 def test_three_agents_drive_three_ros2_bases_to_complete_coverage(tmp_path):
-    """The paper's scenario scaled (scenarios/ros2-paper.toml: a 5 m room, 1 m/s, 40 Hz control)."""
-    config = str(ROOT / "scenarios" / "ros2-paper.toml")
-    engine = anicov("run", "--config", config, "--seed", "0", "--out", str(tmp_path / "engine"), "--quiet")
+    """The paper's scenario scaled (scenarios/ros2-paper.toml: 1 m/s, 40 Hz control) in a 3.5 m room (70 x 70
+    units instead of the file's 100 x 100: 18 s of driving instead of 36)."""
+    shipped = (ROOT / "scenarios" / "ros2-paper.toml").read_text()
+    assert "domain = [100.0, 100.0]" in shipped
+    config = str(tmp_path / "ros2-room.toml")
+    Path(config).write_text(shipped.replace("domain = [100.0, 100.0]", "domain = [70.0, 70.0]"))
+    engine = anicov(
+        "run", "--config", config, "--seed", "0", "--out", str(tmp_path / "engine"), "--quiet", "--no-record"
+    )
     assert engine.returncode == 0, engine.stderr
     out = tmp_path / "team"
     launched = run(
@@ -45,8 +51,9 @@ def test_three_agents_drive_three_ros2_bases_to_complete_coverage(tmp_path):
     reference = json.loads((tmp_path / "engine" / "summary.json").read_text())["completion_time"]
     ratio = summary["completion_time"] / reference
     (tmp_path / "ratio.txt").write_text(f"{ratio:.3f}\n")
-    # Measured here: 1.03, 1.04, 1.11 (odometry at 30 Hz lags the 40 Hz control; the simulated realtime
-    # team keeps within 15 %, this one within 25 %).
+    # Measured here: 1.03, 1.04, 1.11 in the 100 x 100 room, 1.02, 1.02 in this one, 1.17 in a 60 x 60 one
+    # (odometry at 30 Hz lags the 40 Hz control and the start weighs more in a short run; the simulated
+    # realtime team keeps within 15 %, this one within 25 %).
     assert 0.85 <= ratio <= 1.25, ratio
     assert (out / "recording.rrd").stat().st_size > 0
     for agent in range(3):

@@ -116,7 +116,7 @@ def test_an_agent_cannot_publish_as_another_agent_or_as_the_coordinator(profile,
 
 def test_a_secure_team_runs_to_completion_and_equals_the_engine(tmp_path, profile):
     config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=2, seed=3)
-    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet")
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
     assert engine.returncode == 0, engine.stderr
     command = launcher_command(
         "--config", str(config), "--out", str(tmp_path / "team"), "--secure", str(profile.directory), team=TEAM
