@@ -14,17 +14,20 @@ from scipy.optimize import linear_sum_assignment
 from anicov.engine import run_scenario
 from model.control import pursuit_law
 from model.lane_planner import (
+    CENTRE_ALLOWANCE_LEADS,
     LOOKAHEAD,
     LanePlanner,
     Route,
     assign_pieces,
     balanced_routes,
+    balanced_routes_on,
     best_lane_spacing,
     blob_passes,
     bottleneck_assignment,
     lead_in,
     spiral_path,
     spiral_pieces,
+    spiral_variants,
 )
 from model.metrics import coverage_distance, straight_pass_coverage
 from model.scenario import Scenario, ScenarioError, load_scenario
@@ -89,11 +92,40 @@ def test_balanced_pieces_make_every_robot_finish_closer_together_than_equal_ones
     positions = np.random.default_rng(2).uniform(0, 100, (6, 2))
 
     def finishes(routes):
-        return [Route.of(route).length for route in routes]  # transit + run-up + piece: time at k_v
+        """Transit + run-up + piece (time at k_v), and the passes left at the centre for the robot that ends
+        there (CENTRE_ALLOWANCE_LEADS run-ups)."""
+        lengths = np.array([Route.of(route).length for route in routes])
+        at_centre = np.argmin([np.linalg.norm(route[-1] - 50.0) for route in routes])
+        lengths[at_centre] += CENTRE_ALLOWANCE_LEADS * lead
+        return lengths
 
     equal = finishes(assign_pieces(spiral_pieces(scenario, spacing), positions, lead))
     balanced = finishes(balanced_routes(scenario, spacing, positions, lead))
     assert max(balanced) < max(equal)
+    assert max(balanced) - min(balanced) < 2.0  # every robot, the one at the centre too, done together
+    # The robot whose piece ends at the centre flies that much less spiral.
+    flown = np.array([Route.of(route).length for route in balanced_routes(scenario, spacing, positions, lead)])
+    assert np.sort(flown)[1] - flown.min() == pytest.approx(CENTRE_ALLOWANCE_LEADS * lead, abs=2.0)
+
+
+def test_the_spiral_is_flown_in_whichever_of_its_8_symmetries_finishes_first():
+    scenario = PAPER.with_overrides(agents=4, domain=[100.0, 60.0])
+    spacing, lead = best_lane_spacing(scenario), lead_in(scenario, best_lane_spacing(scenario))
+    variants = spiral_variants(scenario, spacing)
+    lengths = [Route.of(variant).length for variant in variants]
+    assert lengths == pytest.approx([lengths[0]] * 8)  # the same rings ...
+    assert len({tuple(np.round(variant[0], 6)) for variant in variants}) == 4  # ... from each corner ...
+    assert len({tuple(np.round(np.r_[variant[0], variant[1]], 6)) for variant in variants}) == 8  # either way round
+    for variant in variants:
+        assert variant[:, 0].min() > 0.0 and variant[:, 0].max() < 100.0
+        assert variant[:, 1].min() > 0.0 and variant[:, 1].max() < 60.0
+    positions = np.random.default_rng(7).uniform([0.0, 0.0], [100.0, 60.0], (4, 2))
+    finishes = [balanced_routes_on(scenario, variant, positions, lead)[1] for variant in variants]
+    chosen = balanced_routes(scenario, spacing, positions, lead)
+    best = int(np.argmin(finishes))
+    assert min(finishes) < finishes[0]  # here the spiral as drawn is not the best start
+    expected = balanced_routes_on(scenario, variants[best], positions, lead)[0]
+    assert all(np.array_equal(a, b) for a, b in zip(chosen, expected, strict=True))
 
 
 def test_progress_follows_the_robot_along_its_route_never_back_and_never_onto_the_next_ring():
