@@ -11,7 +11,8 @@ straight pass at full speed wastes least. So:
    from the centre line. Lanes back and forth need a run-up of about R outside the domain at every
    lane's start (a forward camera sees a point beside a lane only from behind it); a spiral needs one.
 2. **Pieces.** The spiral is cut into N pieces, flown inward (flown outward, a ring's corners leave
-   gaps no later ring closes), each entered :func:`lead_in` before its first point. Robots take pieces
+   gaps no later ring closes), the first entered :func:`lead_in` before the spiral's start, the others
+   where the piece before them ends (its robot's camera covered ahead of that end). Robots take pieces
    by the assignment that minimises the longest transit, then the total (:func:`bottleneck_assignment`
    on scipy's ``linear_sum_assignment``), and the pieces are resized until transit, run-up and flight
    take every robot about as long (:func:`balanced_routes`): the team finishes with its slowest robot.
@@ -248,8 +249,11 @@ def balanced_routes_on(
         cuts[-1] = total
         pieces = cut(whole, cuts)
         routes, owners = assign_pieces(pieces, positions, lead, with_owners=True)
-        transit = allowance + np.array(
-            [np.linalg.norm(routes[owners[k]][1] - positions[owners[k]]) + lead for k in range(len(pieces))]
+        run_ups = np.where(np.arange(len(pieces)) == 0, lead, 0.0)  # the spiral's start only (assign_pieces)
+        transit = (
+            allowance
+            + run_ups
+            + np.array([np.linalg.norm(routes[owners[k]][1] - positions[owners[k]]) for k in range(len(pieces))])
         )
         finish = float(np.max(transit + lengths))
         if finish < best_finish:
@@ -286,11 +290,14 @@ def bottleneck_assignment(cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def assign_pieces(pieces: list[np.ndarray], positions: np.ndarray, lead: float, with_owners: bool = False) -> Any:
-    """Each robot's route: its start, then its piece entered ``lead`` before the piece's first point.
-    Pieces are flown the way the spiral goes (inward: flown outward, a ring's corners leave gaps the
-    next ring does not close); the assignment minimises the longest transit, then the total.
-    ``with_owners``: also each piece's robot."""
-    entries = [with_run_up(piece, lead) for piece in pieces]
+    """Each robot's route: its start, then its piece. The first piece (the spiral's start) is entered
+    ``lead`` before its first point; the others start where the piece before them ends: a point beside
+    the spiral just past a seam is seen by the camera of the robot ending there from behind, as a run-up
+    would (measured, 8 seeds, without a run-up at the seams: N = 4 2.65 -> 2.61 t*, N = 10 2.98 -> 2.88,
+    N = 30 3.59 -> 3.41). Pieces are flown the way the spiral goes (inward: flown outward, a ring's
+    corners leave gaps the next ring does not close); the assignment minimises the longest transit,
+    then the total. ``with_owners``: also each piece's robot."""
+    entries = [with_run_up(piece, lead) if k == 0 else piece for k, piece in enumerate(pieces)]
     transit = np.array([[np.linalg.norm(route[0] - p) for route in entries] for p in positions])
     robots, chosen = bottleneck_assignment(transit)
     routes: list[np.ndarray] = [np.zeros((0, 2))] * len(positions)

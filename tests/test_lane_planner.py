@@ -60,7 +60,7 @@ def test_the_spiral_stays_inside_its_rings_at_most_a_spacing_apart_down_to_the_c
     assert wide[:, 0].max() > 190.0 and wide[:, 1].max() < 50.0
 
 
-def test_the_pieces_cover_the_spiral_and_each_robot_flies_one_inward_after_a_run_up():
+def test_the_pieces_cover_the_spiral_and_each_robot_flies_one_inward_the_first_after_a_run_up():
     scenario = PAPER.with_overrides(agents=3)
     spacing = best_lane_spacing(scenario)
     whole = Route.of(spiral_path(scenario, spacing)).length
@@ -69,9 +69,13 @@ def test_the_pieces_cover_the_spiral_and_each_robot_flies_one_inward_after_a_run
     starts = np.array([pieces[2][0] + [1.0, 0.0], pieces[0][-1] + [0.0, 1.0], pieces[1][0]])
     routes = assign_pieces(pieces, starts, lead=5.0)
     assert all(np.allclose(route[0], start) for route, start in zip(routes, starts, strict=True))
-    for route in routes:  # its piece, flown as the spiral goes, entered 5 before its first point
-        piece = next(piece for piece in pieces if np.allclose(route[-1], piece[-1]))
-        assert np.allclose(route[2:], piece) and np.linalg.norm(route[2] - route[1]) == pytest.approx(5.0)
+    for route in routes:  # its piece, flown as the spiral goes; the spiral's start entered 5 before it
+        k, piece = next((k, piece) for k, piece in enumerate(pieces) if np.allclose(route[-1], piece[-1]))
+        if k == 0:
+            assert np.allclose(route[2:], piece) and np.linalg.norm(route[2] - route[1]) == pytest.approx(5.0)
+            assert np.allclose(route[1], piece[0] - 5.0 * (piece[1] - piece[0]) / np.linalg.norm(piece[1] - piece[0]))
+        else:  # where the piece before it ends
+            assert np.allclose(route[1:], piece) and np.allclose(route[1], pieces[k - 1][-1])
     assert sorted(np.allclose(route[-1], piece[-1]) for route in routes for piece in pieces).count(True) == 3
 
 
