@@ -9,8 +9,9 @@ import pytest
 from coordinator.node import Coordinator, CoordinatorOptions
 from coordinator.rebuild import by_step, rebuild, resume_step
 from model.coverage_map import CoverageMap
-from model.lane_planner import LanePlanner, best_lane_spacing
+from model.lane_planner import LanePlanner
 from model.parameters import initial_poses
+from model.routes import best_lane_spacing
 from tests.test_coordinator_node import SCENARIO, team_steps
 
 

@@ -1,0 +1,285 @@
+"""The ``anicov`` controller's routes: the robot's polyline and its progress, the spiral at the sensor's best
+spacing, its pieces and who flies which.
+
+Beyond the paper (docs/controller.md has the measurements and the reasons; :mod:`model.lane_planner` is
+the planner that gives the carrots along these routes):
+
+- :func:`best_lane_spacing`: from eq. 2, the widest spacing at which two neighbouring passes at k_v still
+  bring the point midway to Λ*; :func:`lead_in`: how far before a lane a forward camera must start.
+- :func:`spiral_path`: a rectangular spiral inward, its rings evenly spaced at most that spacing apart,
+  the outer ring d100 inside the edges; :func:`spiral_variants`: the same in the domain's 8 symmetries.
+- :func:`balanced_routes`: the spiral cut into N pieces flown inward, robots assigned to pieces by the
+  least longest transit (:func:`bottleneck_assignment` on scipy's ``linear_sum_assignment``), the pieces
+  resized until every robot finishes together, on the symmetry that finishes first.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import cv2
+import numpy as np
+from scipy.optimize import linear_sum_assignment, minimize_scalar
+
+from model.metrics import coverage_distance, straight_pass_coverage
+from model.scenario import Scenario
+from model.zigzag import path_between, point_along
+
+BALANCING_ROUNDS = 10
+"""Rounds of resizing the pieces so that every robot finishes together (balanced_routes)."""
+MIN_PIECE = 0.2
+"""No piece shorter than this share of an equal one (a robot far from everything still flies some)."""
+CENTRE_ALLOWANCE_LEADS = 8.0
+"""Run-ups of extra work counted for the robot whose piece ends at the spiral's centre (balanced_routes)."""
+
+
+def best_lane_spacing(scenario: Scenario) -> float:
+    """The lane spacing s that covers most area per unit time, from eq. 2 (Fig. 7's straight pass).
+
+    Two neighbouring passes at speed v bring the point midway between them Λ = 2 C(s/2) / v, C the
+    one-pass coverage at speed 1 (:func:`model.metrics.straight_pass_coverage`; the midpoint is the
+    least covered point between them, C being convex). The fastest speed that still reaches Λ* is
+    v(s) = min(k_v, 2 C(s/2) / Λ*), and the area swept per unit time s·v(s) is largest at the returned s.
+    """
+
+    def rate(spacing: float) -> float:
+        midway = straight_pass_coverage(spacing / 2.0, scenario.range, scenario.half_angle, scenario.alpha_max)
+        return -spacing * min(scenario.k_v, 2.0 * midway / scenario.lambda_star)
+
+    reach = 2.0 * scenario.range * math.sin(scenario.half_angle)
+    found = minimize_scalar(rate, bounds=(1e-3 * reach, reach), method="bounded", options={"xatol": 1e-6})
+    return float(found.x)
+
+
+def lead_in(scenario: Scenario, spacing: float) -> float:
+    """How far before a lane's first point the robot enters it: a point half a spacing beside the lane
+    comes into the wedge (half angle F) only once the robot is (s/2)/tan F behind it."""
+    return min(scenario.range, spacing / 2.0 / math.tan(scenario.half_angle))
+
+
+@dataclass
+class Route:
+    """A robot's polyline and how far along it (arc length) the robot has come."""
+
+    points: np.ndarray  # (K, 2)
+    along: np.ndarray  # (K,) cumulative arc length
+    progress: float = 0.0
+    cleanup: bool = False  # a pass over a blob (True) or the robot's piece of the lanes
+
+    @classmethod
+    def of(cls, points: np.ndarray, cleanup: bool = False) -> Route:
+        points = np.asarray(points, dtype=np.float64)
+        keep = np.concatenate([[True], np.linalg.norm(np.diff(points, axis=0), axis=1) > 1e-9])
+        points = points[keep]
+        along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+        return cls(points, along, 0.0, cleanup)
+
+    @property
+    def length(self) -> float:
+        return float(self.along[-1])
+
+    def point_at(self, distance: float) -> np.ndarray:
+        """The point ``distance`` along the route, held to its ends."""
+        if len(self.points) == 1:
+            return self.points[0].copy()
+        return point_along(self.points, self.along, min(max(distance, 0.0), self.length))
+
+    def advance(self, position: np.ndarray, window: float) -> None:
+        """Progress := the nearest point of the route to ``position`` at most ``window`` ahead of where
+        it was: no farther than the carrot the robot was given (so a neighbouring ring is never taken,
+        nor, on a pass that doubles back over a small blob, the way back while it is still going out);
+        the first such along the route on a tie."""
+        reach = self.progress + window
+        best, best_distance = self.progress, math.inf
+        for k in range(len(self.points) - 1):
+            start, end = self.along[k], self.along[k + 1]
+            if end < self.progress or start > reach:
+                continue
+            at = min(max(self._foot(k, position), self.progress), reach)
+            gap = float(np.linalg.norm(self.point_at(at) - position))
+            if gap < best_distance - 1e-9:
+                best, best_distance = at, gap
+        self.progress = max(self.progress, best)
+
+    def done(self) -> bool:
+        return self.progress >= self.length - 1e-6
+
+    def nearest(self, position: np.ndarray) -> tuple[float, float]:
+        """(distance, arc length) of the route's point nearest to ``position``, the first on a tie."""
+        if len(self.points) == 1:
+            return float(np.linalg.norm(self.points[0] - position)), 0.0
+        best_gap, best_at = math.inf, 0.0
+        for k in range(len(self.points) - 1):
+            at = self._foot(k, position)
+            gap = float(np.linalg.norm(self.point_at(at) - position))
+            if gap < best_gap - 1e-9:
+                best_gap, best_at = gap, at
+        return best_gap, best_at
+
+    def _foot(self, k: int, position: np.ndarray) -> float:
+        """Arc length of the point of segment k nearest to ``position``."""
+        a, b = self.points[k], self.points[k + 1]
+        d = b - a
+        span2 = float(d @ d)
+        t = 0.0 if span2 == 0.0 else float(np.clip((position - a) @ d / span2, 0.0, 1.0))
+        return float(self.along[k] + t * (self.along[k + 1] - self.along[k]))
+
+    def draw_ahead(self, canvas: np.ndarray, cell: float, width: int) -> None:
+        """Draw what is left of the route (from its progress on) into ``canvas`` (uint8 grid), ``width``
+        cells wide."""
+        ahead = self.points[self.along > self.progress]
+        line = np.vstack([self.point_at(self.progress), ahead]) / cell
+        cv2.polylines(canvas, [np.round(line).astype(np.int32)], False, 1, thickness=width)
+
+
+def spiral_path(scenario: Scenario, spacing: float) -> np.ndarray:
+    """The one-robot sweep: a rectangular spiral inward, as a polyline (K, 2). Its outer ring lies d100
+    inside the domain's edges; its rings are evenly spaced, at most ``spacing`` apart, so that the
+    innermost one is at most d100 from the domain's centre line (one pass brings Λ* that far): a
+    spiral whose last ring stopped short would leave its centre to slow passes after it."""
+    width, height = scenario.domain
+    d100 = coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
+    first = min(d100, width / 2.0, height / 2.0)
+    inward = min(width, height) / 2.0 - 2.0 * first  # from the outer ring to where the innermost may be
+    rings = max(0, math.ceil(inward / spacing - 1e-9))
+    step = inward / rings if rings else 0.0
+    points: list[tuple[float, float]] = []
+    for ring in range(rings + 1):
+        left, bottom = first + ring * step, first + ring * step
+        right, top = width - left, height - bottom
+        if ring < rings:
+            points += [(left, bottom), (right, bottom), (right, top), (left, top), (left, bottom + step)]
+        elif top - bottom > 1e-9 and right - left > 1e-9:
+            points += [(left, bottom), (right, bottom), (right, top), (left, top), (left, bottom)]
+        else:  # the innermost ring is a line along the longer side
+            points += [(left, bottom), (right, top)]
+    return np.array(points, dtype=np.float64)
+
+
+def spiral_pieces(scenario: Scenario, spacing: float) -> list[np.ndarray]:
+    """The spiral cut into N pieces of equal length (polylines), one per robot."""
+    whole = Route.of(spiral_path(scenario, spacing))
+    return cut(whole, np.linspace(0.0, whole.length, scenario.agents + 1))
+
+
+def cut(whole: Route, cuts: np.ndarray) -> list[np.ndarray]:
+    """A route cut at ``cuts`` (arc lengths from 0 to its length) into consecutive polylines."""
+    return [path_between(whole.points, low, high) for low, high in itertools.pairwise(cuts)]
+
+
+def spiral_variants(scenario: Scenario, spacing: float) -> list[np.ndarray]:
+    """:func:`spiral_path` in each of the domain rectangle's 8 symmetries (started from each corner, either
+    way round): the same rings, flown inward, their starts in other places."""
+    width, height = scenario.domain
+    along_x = spiral_path(scenario, spacing)
+    along_y = spiral_path(scenario.with_overrides(domain=[height, width]), spacing)[:, ::-1]  # transposed
+    variants = []
+    for path in (along_x, along_y):
+        for flip_x, flip_y in itertools.product((False, True), repeat=2):
+            variant = np.array(path, dtype=np.float64)
+            if flip_x:
+                variant[:, 0] = width - variant[:, 0]
+            if flip_y:
+                variant[:, 1] = height - variant[:, 1]
+            variants.append(variant)
+    return variants
+
+
+def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, lead: float) -> list[np.ndarray]:
+    """Each robot's route, its piece sized so that the team finishes together, on whichever of the
+    spiral's 8 symmetries (:func:`spiral_variants`) gives the earliest estimated finish (the first on a
+    tie): at random starts, the bottleneck transit depends on where the spiral starts and which way it
+    turns (measured, 4 seeds: N = 4 2.76 -> 2.67 t*, N = 30 3.78 -> 3.58)."""
+    best, best_finish = None, math.inf
+    for path in spiral_variants(scenario, spacing):
+        routes, finish = balanced_routes_on(scenario, path, positions, lead)
+        if finish < best_finish:
+            best, best_finish = routes, finish
+    assert best is not None
+    return best
+
+
+def balanced_routes_on(
+    scenario: Scenario, spiral: np.ndarray, positions: np.ndarray, lead: float
+) -> tuple[list[np.ndarray], float]:
+    """Routes on ``spiral`` and their estimated finish. From equal pieces, each round assigns robots to
+    pieces (:func:`assign_pieces`), then moves every piece's length halfway to the one that makes
+    transit, run-up and flight the same for all; the routes with the earliest estimated finish (longest
+    transit + run-up + piece) are kept. The piece that ends at the centre counts
+    :data:`CENTRE_ALLOWANCE_LEADS` run-ups more: the innermost ring, its sides shorter than a run-up on a
+    square, leaves part of the centre to passes (on the paper's square at N = 1: three, 70 time units),
+    and its robot, near them, takes them while the others finish (measured, 8 seeds: N = 10 3.11 -> 2.88
+    t*; none: the team waited for one robot's passes at the centre)."""
+    whole = Route.of(spiral)
+    total = whole.length
+    if total <= 0.0:  # a domain within 2·d100 on both sides: one point, every robot goes there
+        return [np.vstack([position, whole.points[:1]]) for position in positions], 0.0
+    lengths = np.full(scenario.agents, total / scenario.agents)
+    allowance = np.zeros(scenario.agents)
+    allowance[-1] = CENTRE_ALLOWANCE_LEADS * lead if scenario.agents > 1 else 0.0
+    best, best_finish = None, math.inf
+    for _ in range(BALANCING_ROUNDS + 1):
+        cuts = np.concatenate([[0.0], np.cumsum(lengths)])
+        cuts[-1] = total
+        pieces = cut(whole, cuts)
+        routes, owners = assign_pieces(pieces, positions, lead, with_owners=True)
+        run_ups = np.where(np.arange(len(pieces)) == 0, lead, 0.0)  # the spiral's start only (assign_pieces)
+        transit = (
+            allowance
+            + run_ups
+            + np.array([np.linalg.norm(routes[owners[k]][1] - positions[owners[k]]) for k in range(len(pieces))])
+        )
+        finish = float(np.max(transit + lengths))
+        if finish < best_finish:
+            best, best_finish = routes, finish
+        target = np.maximum((total + transit.sum()) / scenario.agents - transit, MIN_PIECE * total / scenario.agents)
+        lengths = 0.5 * lengths + 0.5 * target / target.sum() * total
+    assert best is not None
+    return best, best_finish
+
+
+def with_run_up(piece: np.ndarray, lead: float) -> np.ndarray:
+    """A piece entered ``lead`` before its first point, along its first stretch (the camera looks ahead)."""
+    direction = piece[1] - piece[0]
+    direction = direction / max(float(np.linalg.norm(direction)), 1e-300)
+    return np.vstack([piece[0] - lead * direction, piece])
+
+
+def bottleneck_assignment(cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows to columns (square ``cost``) minimising the largest cost taken, then the total among those
+    (the team finishes when its slowest robot does): the least threshold that still admits a perfect
+    matching, found by bisection over the costs, then linear_sum_assignment within it."""
+    values = np.unique(cost)
+    low, high = 0, len(values) - 1
+    while low < high:
+        middle = (low + high) // 2
+        allowed = (cost <= values[middle]).astype(np.float64)
+        rows, cols = linear_sum_assignment(-allowed)
+        if allowed[rows, cols].sum() == len(cost):
+            high = middle
+        else:
+            low = middle + 1
+    capped = np.where(cost <= values[low], cost, cost.max() * len(cost) + 1.0)
+    return linear_sum_assignment(capped)
+
+
+def assign_pieces(pieces: list[np.ndarray], positions: np.ndarray, lead: float, with_owners: bool = False) -> Any:
+    """Each robot's route: its start, then its piece. The first piece (the spiral's start) is entered
+    ``lead`` before its first point; the others start where the piece before them ends: a point beside
+    the spiral just past a seam is seen by the camera of the robot ending there from behind, as a run-up
+    would (measured, 8 seeds, without a run-up at the seams: N = 4 2.65 -> 2.61 t*, N = 10 2.98 -> 2.88,
+    N = 30 3.59 -> 3.41). Pieces are flown the way the spiral goes (inward: flown outward, a ring's
+    corners leave gaps the next ring does not close); the assignment minimises the longest transit,
+    then the total. ``with_owners``: also each piece's robot."""
+    entries = [with_run_up(piece, lead) if k == 0 else piece for k, piece in enumerate(pieces)]
+    transit = np.array([[np.linalg.norm(route[0] - p) for route in entries] for p in positions])
+    robots, chosen = bottleneck_assignment(transit)
+    routes: list[np.ndarray] = [np.zeros((0, 2))] * len(positions)
+    owners = [0] * len(pieces)
+    for robot, piece in zip(robots, chosen, strict=True):
+        routes[robot] = np.vstack([positions[robot][None, :], entries[piece]])
+        owners[piece] = int(robot)
+    return (routes, owners) if with_owners else routes
