@@ -61,3 +61,12 @@ def wedge_cell_range(
     row0 = math.ceil(y_min / cell - 0.5)
     row1 = math.floor(y_max / cell - 0.5) + 1
     return row0, row1, col0, col1
+
+
+@njit(cache=True)
+def square_gap2(left: float, bottom: float, side: float) -> float:
+    """Squared distance from the origin to the nearest point of the square [left, left + side] x
+    [bottom, bottom + side] (0 when the origin lies in it or on its edge)."""
+    gap_x = max(left, 0.0, -left - side)
+    gap_y = max(bottom, 0.0, -bottom - side)
+    return gap_x * gap_x + gap_y * gap_y

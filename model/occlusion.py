@@ -24,6 +24,7 @@ import math
 import numpy as np
 from numba import njit
 
+from model.geometry import square_gap2
 from model.ground import Ground
 
 SHADOW_BINS = 64
@@ -66,9 +67,7 @@ def wall_shadows(
             if not ground.occupied[row, col] or _inside_a_wall(ground.occupied, row, col, rows, cols):
                 continue  # a segment reaches a cell inside a wall only through the wall cells around it
             left, bottom = col * cell - x, row * cell - y
-            gap_x = max(left, 0.0, -left - cell)
-            gap_y = max(bottom, 0.0, -bottom - cell)
-            nearest2 = gap_x * gap_x + gap_y * gap_y
+            nearest2 = square_gap2(left, bottom, cell)
             if nearest2 > reach2:
                 continue
             smallest, largest, farthest2, behind = _square_span(left, bottom, cell, heading_x, heading_y)

@@ -27,6 +27,7 @@ from numba import njit
 
 from model.control import global_law_around_walls
 from model.geodesic import descent_waypoint
+from model.geometry import square_gap2
 from model.ground import Ground
 from model.visibility import first_occupied_crossed, hidden_by_teammates, line_of_sight
 
@@ -162,8 +163,7 @@ def _look_bin(dx: float, dy: float) -> int:
 def _shadow_behind(beyond: np.ndarray, left: float, bottom: float, cell: float) -> None:
     """Mark the bins wholly inside the angular span of the square with lower-left corner (left, bottom)
     relative to the robot with the squared distance of its farthest corner."""
-    gap_x, gap_y = max(left, 0.0, -left - cell), max(bottom, 0.0, -bottom - cell)
-    if gap_x * gap_x + gap_y * gap_y < 1e-12:
+    if square_gap2(left, bottom, cell) < 1e-12:
         return  # the robot on its edge: no span to speak of
     centre = math.atan2(bottom + 0.5 * cell, left + 0.5 * cell)
     low, high, farthest2 = math.inf, -math.inf, 0.0

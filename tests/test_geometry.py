@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from model.geometry import wedge_bounds, wedge_cell_range, wrap_angle
+from model.geometry import square_gap2, wedge_bounds, wedge_cell_range, wrap_angle
 
 angles = st.floats(-50.0, 50.0, allow_nan=False)
 
@@ -37,3 +37,11 @@ def test_wedge_cell_range_covers_cell_centres_in_box():
     assert col0 == 50 and col1 == 70
     # Half angle 0.5 rad: y spans 50.7 ± 20·sin 0.5 = [41.11, 60.29] → centres 41.5 .. 59.5.
     assert row0 == 41 and row1 == 60
+
+
+@given(st.floats(-30.0, 30.0), st.floats(-30.0, 30.0), st.floats(0.1, 5.0))
+def test_square_gap2_is_the_squared_distance_to_the_nearest_point_of_the_square(left, bottom, side):
+    nearest_x = min(max(0.0, left), left + side)  # the origin clamped into the square
+    nearest_y = min(max(0.0, bottom), bottom + side)
+    assert math.isclose(square_gap2(left, bottom, side), nearest_x**2 + nearest_y**2, rel_tol=1e-12, abs_tol=1e-12)
+    assert square_gap2(-side / 2.0, -side / 2.0, side) == 0.0  # the origin inside
