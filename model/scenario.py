@@ -105,7 +105,7 @@ class Scenario:
     @property
     def plan_steps(self) -> int:
         """Steps between two plans: replan_period's (Algorithms 1-2), or the anicov controller's carrot
-        period (model.lane_planner.CARROT_PERIOD, 0.5 time units)."""
+        period (CARROT_PERIOD, 0.5 time units)."""
         if self.controller == "anicov":
             return max(1, round(CARROT_PERIOD / self.dt))
         return self.replan_steps
