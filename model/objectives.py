@@ -11,7 +11,11 @@ Objectives Ψ and their blobs π_j persist between calls. Each call
 3. erodes what is left and repeats until nothing is left (lines 15–24), so
    irregular blobs (rings, C and L shapes, Fig. 3) shrink until their
    centroids land on uncovered cells;
-4. gives the eroded cells to the nearest blob (line 25).
+4. gives the eroded cells to the nearest blob (line 25). On a terrain (``by_paths``) "nearest" is
+   taken through uncovered cells, not across walls: an eroded cell goes to the blob its uncovered
+   region reaches first (:func:`by_paths_through`), and what reaches none forms blobs of its own. The straight
+   nearest blob gave a room's leftovers to the blobs of the rooms beside it, whose objectives held
+   them while the room waited (docs/terrain.md).
 
 If no objective survives while cells are still uncovered (a symmetric map
 that erodes away entirely), the uncovered cell nearest to the team is the
@@ -65,8 +69,11 @@ def select_objectives(
     previous: BlobObjectives,
     cell: float,
     merge_distance: float,
+    by_paths: bool = False,
 ) -> BlobObjectives:
-    """Algorithm 1 on the lack-of-coverage map Υ; ``merge_distance`` is R."""
+    """Algorithm 1 on the lack-of-coverage map Υ; ``merge_distance`` is R. ``by_paths`` (a terrain with
+    walls): line 25 through uncovered cells (:func:`by_paths_through`); the paper's empty domain keeps the
+    straight nearest blob."""
     kept = _keep_objectives(previous, lack, cell, merge_distance) if previous.count else []
     labels = np.zeros(lack.shape, dtype=np.int32)
     positions: list[np.ndarray] = []
@@ -95,11 +102,40 @@ def select_objectives(
         blob_domain = cv2.erode(blob_domain, _ERODE_KERNEL)
 
     eroded = uncovered & (labels == 0)
-    if positions and eroded.any():
+    if by_paths and eroded.any():
+        labels = by_paths_through(uncovered, labels, eroded, positions, cell)
+    elif positions and eroded.any():
         _, nearest = ndimage.distance_transform_edt(labels == 0, return_indices=True)
         labels[eroded] = labels[nearest[0][eroded], nearest[1][eroded]]
     stacked = np.array(positions, dtype=np.float64).reshape(-1, 2)
     return BlobObjectives(positions=stacked, labels=labels)
+
+
+def by_paths_through(
+    uncovered: np.ndarray, labels: np.ndarray, eroded: np.ndarray, positions: list[np.ndarray], cell: float
+) -> np.ndarray:
+    """Line 25 on a terrain: each eroded cell takes the label of the blob that reaches it first by
+    8-connected steps through uncovered cells (a wavefront from every blob at once; the larger label on
+    a tie, so every replica gets the same); each region of eroded cells no blob reaches becomes a blob of
+    its own, its objective (appended to ``positions``) the region's cell nearest its centroid (the
+    first in row order on a tie), so that every uncovered cell has an objective on its own side of the
+    walls. Returns the new labels."""
+    reached = labels.copy()
+    while True:
+        grown = ndimage.grey_dilation(reached, footprint=np.ones((3, 3), dtype=bool))
+        front = uncovered & (reached == 0) & (grown > 0)
+        if not front.any():
+            break
+        reached[front] = grown[front]
+    labels = np.where(eroded, reached, labels)
+    alone = eroded & (labels == 0)
+    count, regions = cv2.connectedComponents(alone.astype(np.uint8), connectivity=8)
+    for k in range(1, count):
+        rows, cols = np.nonzero(regions == k)
+        nearest = int(np.argmin((rows - rows.mean()) ** 2 + (cols - cols.mean()) ** 2))
+        labels[rows, cols] = len(positions) + 1
+        positions.append(np.array([(cols[nearest] + 0.5) * cell, (rows[nearest] + 0.5) * cell]))
+    return labels
 
 
 def fallback_objective(lack: np.ndarray, agent_positions: np.ndarray, cell: float) -> np.ndarray | None:

@@ -39,14 +39,15 @@ class Planner:
         if self.scenario.objectives:
             ids = range(len(positions)) if members is None else members
             return np.array([self.scenario.objectives[agent] for agent in ids], dtype=np.float64).reshape(-1, 2)
-        self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range)
+        world = world_of(self.scenario)
+        terrain = bool(world.ground.walls)
+        self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range, by_paths=terrain)
         objectives = self.blobs.positions
         if len(objectives) == 0:
             fallback = fallback_objective(lack, positions, self.scenario.cell)
             if fallback is None:
                 return positions.copy()
             objectives = fallback[None, :]
-        world = world_of(self.scenario)
         if not world.ground.walls:
             return objectives[assign_objectives(positions, objectives)]
         objectives = nearest_reachable(world.reachable, objectives, self.scenario.cell)

@@ -2,8 +2,9 @@
 
 import numpy as np
 import pytest
+from scipy.ndimage import distance_transform_edt
 
-from model.objectives import BlobObjectives, cell_of, fallback_objective, select_objectives
+from model.objectives import BlobObjectives, by_paths_through, cell_of, fallback_objective, select_objectives
 
 CELL = 1.0
 R = 20.0
@@ -127,3 +128,52 @@ def test_objectives_of_fig3_shapes_spread_over_the_shape(shape):
     if result.count == 0:
         pytest.skip("uniform shape erodes away: covered by the fallback test")
     assert set(np.unique(result.labels[mask])) == set(range(1, result.count + 1))
+
+
+def u_beside_a_square() -> np.ndarray:
+    """A 10 x 10 blob left of a wall (column 15, never uncovered) and, right of it, a thin U whose
+    centroid lies in its hollow: it erodes away without becoming a blob, so line 25 places its cells."""
+    mask = np.zeros((30, 30), dtype=bool)
+    mask[10:20, 2:12] = True
+    mask[8:22, 18] = True  # the U: two arms and a bottom
+    mask[8:22, 24] = True
+    mask[8, 18:25] = True
+    return lack_with(mask)
+
+
+def test_in_the_open_line_25_gives_eroded_cells_to_the_straight_nearest_blob():
+    lack = u_beside_a_square()
+    result = select_objectives(lack, BlobObjectives(), CELL, R)
+    assert result.count == 1  # the U's cells went to the square's blob, across the wall
+    assert (result.labels[lack > 0] == 1).all()
+
+
+def test_on_a_terrain_eroded_cells_no_blob_reaches_through_uncovered_cells_get_their_own_objective():
+    lack = u_beside_a_square()
+    result = select_objectives(lack, BlobObjectives(), CELL, R, by_paths=True)
+    check_invariants(lack, result)
+    assert result.count == 2
+    u = result.labels[8, 18]
+    right_of_the_wall = (lack > 0) & (np.arange(30) > 15)[None, :]
+    assert u != result.labels[15, 5] and (result.labels[right_of_the_wall] == u).all()
+    assert result.positions[u - 1][0] > 15.0  # its objective on its side of the wall, on one of its cells
+
+
+def test_on_a_terrain_an_eroded_cell_takes_the_blob_its_uncovered_cells_reach_not_the_straight_nearest():
+    """Blob 1 at the left, blob 2 just across a wall from the eroded cells, which a strip of uncovered cells
+    joins to blob 1 only."""
+    uncovered = np.zeros((12, 20), dtype=bool)
+    labels = np.zeros((12, 20), dtype=np.int32)
+    uncovered[0:4, 0:4] = True
+    labels[0:4, 0:4] = 1  # blob 1
+    uncovered[8:12, 14:18] = True
+    labels[8:12, 14:18] = 2  # blob 2, beyond the wall (row 7 is never uncovered)
+    uncovered[2, 4:16] = True  # eroded: a strip from blob 1 ...
+    uncovered[2:6, 15] = True  # ... ending 2 cells from blob 2, across the wall
+    eroded = uncovered & (labels == 0)
+    positions = [np.array([2.0, 2.0]), np.array([16.0, 10.0])]
+    result = by_paths_through(uncovered, labels, eroded, positions, CELL)
+    assert (result[eroded] == 1).all() and len(positions) == 2
+    # The straight nearest blob, as in the open, gives the strip's end to blob 2.
+    _, nearest = distance_transform_edt(labels == 0, return_indices=True)
+    assert labels[nearest[0][5, 15], nearest[1][5, 15]] == 2
