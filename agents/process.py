@@ -245,8 +245,9 @@ coordinator waits for every hello)."""
 
 def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
     """No coordinator: wait until every agent of the team answers with this agent's scenario and map
-    (ScenarioMismatch at the first that does not) and, with ``await_logger``, a logger listens. False: stopped, the launcher gone, or PEERS_TIMEOUT
-    passed (a teammate that died at its start would otherwise keep the others waiting for ever)."""
+    (ScenarioMismatch at the first that does not) and, with ``await_logger``, a logger listens. False:
+    stopped, the launcher gone, or PEERS_TIMEOUT passed (a teammate that died at its start would
+    otherwise keep the others waiting for ever)."""
     node = bus.node
     mine = digest_of(node.scenario)
     deadline = time.monotonic() + PEERS_TIMEOUT

@@ -5,20 +5,22 @@ paper's law show: a robot stands R/2 from a blob's centroid and stares at it (eq
 whose ability α (eq. 2) is five times Λ* at its apex wastes most of what it senses while standing; a
 straight pass at full speed wastes least. So:
 
-1. **A spiral.** A rectangular spiral inward (:func:`model.routes.spiral_path`), its rings evenly spaced at most
-   :func:`model.routes.best_lane_spacing` apart (from eq. 2: the widest spacing at which two neighbouring passes at
-   k_v still bring the point midway to Λ*), the outer ring d100 inside the edges, the innermost d100
-   from the centre line. Lanes back and forth need a run-up of about R outside the domain at every
-   lane's start (a forward camera sees a point beside a lane only from behind it); a spiral needs one.
+1. **A spiral.** A rectangular spiral inward (:func:`model.routes.spiral_path`), its rings evenly
+   spaced at most :func:`model.routes.best_lane_spacing` apart (from eq. 2: the widest spacing at
+   which two neighbouring passes at k_v still bring the point midway to Λ*), the outer ring d100 inside
+   the edges, the innermost d100 from the centre line. Lanes back and forth need a run-up of about R
+   outside the domain at every lane's start (a forward camera sees a point beside a lane only from
+   behind it); a spiral needs one.
 2. **Pieces.** The spiral is cut into N pieces, flown inward (flown outward, a ring's corners leave
-   gaps no later ring closes), the first entered :func:`model.routes.lead_in` before the spiral's start, the others
-   where the piece before them ends (its robot's camera covered ahead of that end). Robots take pieces
-   by the assignment that minimises the longest transit, then the total (:func:`model.routes.bottleneck_assignment`
-   on scipy's ``linear_sum_assignment``), and the pieces are resized until transit, run-up and flight
-   take every robot about as long (:func:`model.routes.balanced_routes`): the team finishes with its slowest robot.
-   The robot whose piece ends at the centre gets less spiral, to take the passes the small innermost
-   ring leaves there; and of the spiral's 8 symmetries (which corner it starts from, which way it
-   turns) the one that finishes soonest is flown.
+   gaps no later ring closes), the first entered :func:`model.routes.lead_in` before the spiral's
+   start, the others where the piece before them ends (its robot's camera covered ahead of that end).
+   Robots take pieces by the assignment that minimises the longest transit, then the total
+   (:func:`model.routes.bottleneck_assignment` on scipy's ``linear_sum_assignment``), and the pieces
+   are resized until transit, run-up and flight take every robot about as long
+   (:func:`model.routes.balanced_routes`): the team finishes with its slowest robot. The robot whose
+   piece ends at the centre gets less spiral, to take the passes the small innermost ring leaves there;
+   and of the spiral's 8 symmetries (which corner it starts from, which way it turns) the one that
+   finishes soonest is flown.
 3. **Passes.** A robot done with its piece takes the uncovered blobs in turns (cells with Υ > 0 within
    a lane spacing of each other, leaving out the strips robots still on their piece will sweep): the
    assignment of free robots to blobs minimises their total distance, and a pass runs along the blob's
@@ -148,8 +150,8 @@ class LanePlanner:
         distance to the passes' entries; a robot left without one stays where it is."""
         # A pass is entered at the blob's near end, with a run-up only to make it ``lead`` long: measured,
         # finishing sooner than a full run-up (``lead``) before every pass (N = 10: 3.10 t* against 3.29;
-        # again on 2026-12-03, 8 seeds: 2.88 against 3.07); a pass
-        # of length 0 over a small blob would park the robot on it, unseen by its forward camera, for ever.
+        # again on 2026-12-03, 8 seeds: 2.88 against 3.07); a pass of length 0 over a small blob would
+        # park the robot on it, unseen by its forward camera, for ever.
         ways, centres, labels = blob_passes(self._unclaimed(lack, ids), self.scenario.cell, self.lead, self.spacing)
         self.blobs = BlobObjectives(centres, labels.astype(np.int32))
         for index in free:  # stay, unless given a pass below

@@ -13,9 +13,9 @@ Objectives Ψ and their blobs π_j persist between calls. Each call
    centroids land on uncovered cells;
 4. gives the eroded cells to the nearest blob (line 25). On a terrain (``by_paths``) "nearest" is
    taken through uncovered cells, not across walls: an eroded cell goes to the blob its uncovered
-   region reaches first (:func:`by_paths_through`), and what reaches none forms blobs of its own. The straight
-   nearest blob gave a room's leftovers to the blobs of the rooms beside it, whose objectives held
-   them while the room waited (docs/terrain.md).
+   region reaches first (:func:`by_paths_through`), and what reaches none forms blobs of its own.
+   The straight nearest blob gave a room's leftovers to the blobs of the rooms beside it, whose
+   objectives held them while the room waited (docs/terrain.md).
 
 If no objective survives while cells are still uncovered (a symmetric map
 that erodes away entirely), the uncovered cell nearest to the team is the
@@ -72,8 +72,8 @@ def select_objectives(
     by_paths: bool = False,
 ) -> BlobObjectives:
     """Algorithm 1 on the lack-of-coverage map Υ; ``merge_distance`` is R. ``by_paths`` (a terrain with
-    walls): line 25 through uncovered cells (:func:`by_paths_through`); the paper's empty domain keeps the
-    straight nearest blob."""
+    walls): line 25 through uncovered cells (:func:`by_paths_through`); the paper's empty domain keeps
+    the straight nearest blob."""
     kept = _keep_objectives(previous, lack, cell, merge_distance) if previous.count else []
     labels = np.zeros(lack.shape, dtype=np.int32)
     positions: list[np.ndarray] = []
@@ -121,7 +121,7 @@ def by_paths_through(
     first in row order on a tie), so that every uncovered cell has an objective on its own side of the
     walls. Returns the new labels."""
     reached = labels.copy()
-    while True:
+    while (eroded & (reached == 0)).any():  # a label, once given, stays: stop when every eroded cell has one
         grown = ndimage.grey_dilation(reached, footprint=np.ones((3, 3), dtype=bool))
         front = uncovered & (reached == 0) & (grown > 0)
         if not front.any():

@@ -48,7 +48,7 @@ class Planner:
             if fallback is None:
                 return positions.copy()
             objectives = fallback[None, :]
-        if not world.ground.walls:
+        if not terrain:
             return objectives[assign_objectives(positions, objectives)]
         objectives = nearest_reachable(world.reachable, objectives, self.scenario.cell)
         return objectives[assign_objectives(positions, objectives, path_lengths(world, positions, objectives))]

@@ -223,8 +223,8 @@ def balanced_routes_on(
     sides are shorter than a run-up and it leaves part of the centre to passes (on the paper's square at
     N = 1: three, 70 time units), which its robot, near them, takes while the others finish (4 seeds,
     with the 8 symmetries: N = 2 2.56 -> 2.47 t*, N = 4 2.67 -> 2.63, N = 10 3.11 -> 2.86; without it the
-    team waited for one robot's passes at the centre). Measured on the 200 x 50 strip too, whose innermost ring is long
-    and thin (4 seeds): N = 10 1.82 -> 1.78 t*, within 0.01 at N = 1, 4 and 30."""
+    team waited for one robot's passes at the centre). Measured on the 200 x 50 strip too, whose
+    innermost ring is long and thin (4 seeds): N = 10 1.82 -> 1.78 t*, within 0.01 at N = 1, 4 and 30."""
     whole = Route.of(spiral)
     total = whole.length
     if total <= 0.0:  # a domain within 2·d100 on both sides: one point, every robot goes there
