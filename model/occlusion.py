@@ -33,8 +33,6 @@ PSEUDO_SLACK = 1e-9
 of a corner's or a cell centre's pseudo-angle (~1e-16), so a cell on the bearing of a square's edge or
 corner is still in a bin the square marks. (Until 2026-12-03 a whole bin each side: half the visible
 cells that went to the exact traversal on the warehouse map went there only for that bin.)"""
-ANGLE_SLACK = 1e-9
-"""The same for a teammate's tangents, in radians."""
 
 
 @njit(cache=True)
@@ -59,6 +57,9 @@ def wall_shadows(
     rows, cols = ground.occupied.shape
     heading_x, heading_y = math.cos(theta), math.sin(theta)
     reach2 = sensing_range * sensing_range
+    # A square wholly on the far side of the line of an edge of the wedge (bearings F to F + 180°, or the
+    # mirror) holds no bearing of the wedge: its circumscribed circle clear of that line is enough to tell.
+    cos_half_angle, sin_half_angle, circumradius = math.cos(half_angle), math.sin(half_angle), 0.7072 * cell
     # The window of the wedge's cells and the robot's own cell: a segment between them stays inside.
     row0, row1 = min(row0, math.floor(y / cell)), max(row1, math.floor(y / cell) + 1)
     col0, col1 = min(col0, math.floor(x / cell)), max(col1, math.floor(x / cell) + 1)
@@ -68,8 +69,13 @@ def wall_shadows(
                 continue  # a segment reaches a cell inside a wall only through the wall cells around it
             left, bottom = col * cell - x, row * cell - y
             nearest2 = square_gap2(left, bottom, cell)
-            if nearest2 > reach2:
-                continue
+            centre_x, centre_y = left + 0.5 * cell, bottom + 0.5 * cell
+            beside = abs(heading_x * centre_y - heading_y * centre_x) * cos_half_angle
+            if (
+                nearest2 > reach2
+                or beside - (centre_x * heading_x + centre_y * heading_y) * sin_half_angle > circumradius
+            ):
+                continue  # farther than R, or wholly past an edge of the wedge (its circle clear of the edge's line)
             smallest, largest, farthest2, behind = _square_span(left, bottom, cell, heading_x, heading_y)
             if nearest2 == 0.0:
                 # The robot stands on its edge: the traversal's tie rules (a segment from a grid corner)
@@ -106,6 +112,49 @@ def _square_span(
     pseudo-angle ±1 on the side of the crossing. A crossing at the robot itself (within 1e-9: the robot on
     the square's edge) counts on both sides, so every bearing is spanned. A square with no corner in front
     has no part there: smallest > largest (a segment to a cell in front never enters it)."""
+    right, top = left + cell, bottom + cell
+    if left > 0.0 or right < 0.0 or bottom > 0.0 or top < 0.0:
+        # Seen from outside, the span's ends are two corners known from where the robot lies (the
+        # clockwise-most, then the anticlockwise-most); when both are in front, so is every corner.
+        if left > 0.0:  # to the right of the robot: above it, below it, or level with it
+            if bottom > 0.0:
+                first_x, first_y, last_x, last_y = right, bottom, left, top
+            elif top < 0.0:
+                first_x, first_y, last_x, last_y = left, bottom, right, top
+            else:
+                first_x, first_y, last_x, last_y = left, bottom, left, top
+        elif right < 0.0:  # to its left
+            if bottom > 0.0:
+                first_x, first_y, last_x, last_y = right, top, left, bottom
+            elif top < 0.0:
+                first_x, first_y, last_x, last_y = left, top, right, bottom
+            else:
+                first_x, first_y, last_x, last_y = right, top, right, bottom
+        elif bottom > 0.0:  # straight above it
+            first_x, first_y, last_x, last_y = right, bottom, left, bottom
+        else:  # straight below it
+            first_x, first_y, last_x, last_y = left, top, right, top
+        first_along = first_x * heading_x + first_y * heading_y
+        last_along = last_x * heading_x + last_y * heading_y
+        if first_along > 0.0 and last_along > 0.0:
+            first_across = heading_x * first_y - heading_y * first_x
+            last_across = heading_x * last_y - heading_y * last_x
+            farthest2 = max(left * left, right * right) + max(bottom * bottom, top * top)
+            return (
+                first_across / (first_along + abs(first_across)),
+                last_across / (last_along + abs(last_across)),
+                farthest2,
+                False,
+            )
+    return _square_span_by_corners(left, bottom, cell, heading_x, heading_y)
+
+
+@njit(cache=True)
+def _square_span_by_corners(
+    left: float, bottom: float, cell: float, heading_x: float, heading_y: float
+) -> tuple[float, float, float, bool]:
+    """:func:`_square_span` from all four corners and the crossings of the robot's sideways line: every
+    case, the robot on the square's edge and squares reaching beside or behind it included."""
     corners_x = (left, left + cell, left + cell, left)  # counter-clockwise: edge k joins corners k and k + 1
     corners_y = (bottom, bottom, bottom + cell, bottom + cell)
     smallest, largest, farthest2, behind = math.inf, -math.inf, 0.0, False
@@ -177,30 +226,36 @@ def add_teammate_shadows(
     shadows: np.ndarray, teammates: np.ndarray, radius: float, x: float, y: float, theta: float, half_angle: float
 ) -> None:
     """Mark the bins a teammate's disk may hide, from its nearest point on: the bearings of its two
-    tangents (widened by ANGLE_SLACK), cut to the robot's front half (a segment to a cell in front has a
+    tangents (widened by PSEUDO_SLACK), cut to the robot's front half (a segment to a cell in front has a
     bearing there): a disk that reaches beside the robot spans up to ±90° on its side, one wholly behind
-    it spans nothing. (``teammates`` are never within 2r, so the robot is never inside a disk.)"""
-    quarter = 0.5 * math.pi
+    it spans nothing. (``teammates`` are never within 2r, so the robot is never inside a disk.)
+
+    The tangents are the direction to the centre turned by ±asin(r / gap), taken as rotations in the
+    robot's frame (along the heading, across to its left): no angle is computed."""
+    heading_x, heading_y = math.cos(theta), math.sin(theta)
     for k in range(teammates.shape[0]):
         dx, dy = teammates[k, 0] - x, teammates[k, 1] - y
         gap = math.hypot(dx, dy)
         nearest2 = max(gap - radius, 0.0) ** 2
-        centre = math.atan2(dy, dx) - theta
-        centre = math.atan2(math.sin(centre), math.cos(centre))
-        half = math.asin(min(radius / gap, 1.0))
-        low, high = max(centre - half, -quarter), min(centre + half, quarter)
-        if low > high:
-            continue  # behind the robot (an interval past ±180° wraps round behind it too)
-        first = pseudo_bin(_pseudo(low - ANGLE_SLACK), half_angle)
-        last = pseudo_bin(_pseudo(high + ANGLE_SLACK), half_angle)
+        along, across = (dx * heading_x + dy * heading_y) / gap, (heading_x * dy - heading_y * dx) / gap
+        sine = min(radius / gap, 1.0)
+        cosine = math.sqrt(1.0 - sine * sine)
+        low_along, low_across = along * cosine + across * sine, across * cosine - along * sine  # clockwise
+        high_along, high_across = along * cosine - across * sine, across * cosine + along * sine
+        if (high_along < 0.0 and high_across < 0.0) or (low_along < 0.0 and low_across > 0.0):
+            # The anticlockwise tangent behind on the right (or the clockwise one behind on the left): the
+            # disk spans less than a half turn, so all of it lies behind the robot.
+            continue
+        first = pseudo_bin(_front_pseudo(low_along, low_across) - PSEUDO_SLACK, half_angle)
+        last = pseudo_bin(_front_pseudo(high_along, high_across) + PSEUDO_SLACK, half_angle)
         for b in range(max(first, 0), min(last, SHADOW_BINS - 1) + 1):
             shadows[0, b] = min(shadows[0, b], nearest2)
 
 
 @njit(cache=True)
-def _pseudo(angle: float) -> float:
-    """The pseudo-angle of :func:`pseudo_bin` of a bearing in [−90°, 90°] (±1 at ±90°)."""
-    if abs(angle) >= 0.5 * math.pi:
-        return 1.0 if angle > 0.0 else -1.0
-    slope = math.tan(angle)
-    return slope / (1.0 + abs(slope))
+def _front_pseudo(along: float, across: float) -> float:
+    """The pseudo-angle of :func:`pseudo_bin` of a direction, a bearing behind the robot taken as ±90° on
+    its side (±1)."""
+    if along > 0.0:
+        return across / (along + abs(across))
+    return 1.0 if across > 0.0 else -1.0

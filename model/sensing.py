@@ -53,29 +53,31 @@ def lack_of_coverage(coverage_ticks: int, target_ticks: int) -> float:
 
 
 @njit(cache=True)
-def wedge_polar(
-    cx: float,
-    cy: float,
-    heading_x: float,
-    heading_y: float,
-    sensing_range: float,
-    half_angle: float,
-    cos_half_angle: float,
+def wedge_reach(
+    cx: float, cy: float, heading_x: float, heading_y: float, sensing_range: float, cos_half_angle: float
 ) -> tuple[float, float, float]:
-    """(r, θ_ix, across) of a point at (cx, cy) from the robot when it lies in the wedge (the support of
-    eq. 2), else r = −1. ``across`` > 0: the point is left of the heading."""
+    """(r, along, across) of a point at (cx, cy) from the robot when it lies within R and passes the cone's
+    cheap test (cos θ_ix ≥ cos F, to rounding), else r = −1: the support of eq. 2 before the exact test of
+    :func:`bearing_offset`. ``across`` > 0: the point is left of the heading."""
     distance = math.sqrt(cx * cx + cy * cy)
     if distance > sensing_range:
         return -1.0, 0.0, 0.0
     along = cx * heading_x + cy * heading_y
     across = heading_x * cy - heading_y * cx
-    # Cheap rejection before the arctangent: outside the cone cos(offset) < cos F.
     if along < distance * cos_half_angle - 1e-12:
         return -1.0, 0.0, 0.0
-    offset = abs(math.atan2(across, along)) if distance > 0.0 else 0.0
-    if offset > half_angle:
-        return -1.0, 0.0, 0.0
-    return distance, offset, across
+    return distance, along, across
+
+
+@njit(cache=True)
+def bearing_offset(distance: float, along: float, across: float) -> float:
+    """θ_ix = |θ_i − θ_x| of a point (0 at the robot itself): the wedge holds it when θ_ix ≤ F."""
+    return abs(math.atan2(across, along)) if distance > 0.0 else 0.0
+
+
+SURELY_IN_CONE = 1e-9
+"""How far past the cheap cone test (along ≥ r·cos F) a point must lie for the wedge to hold it surely,
+without the arctangent of the exact test: far more than the rounding of either."""
 
 
 @njit(cache=True)
@@ -118,23 +120,36 @@ def sense_wedge(
         row_inside = 0 <= row < rows
         for col in range(col0, col1):
             cx = (col + 0.5) * cell - x
-            distance, offset, across = wedge_polar(
-                cx, cy, heading_x, heading_y, sensing_range, half_angle, cos_half_angle
-            )
-            cells_in_wedge += distance >= 0.0
-            if distance < 0.0 or not row_inside or col < 0 or col >= cols:
+            distance, along, across = wedge_reach(cx, cy, heading_x, heading_y, sensing_range, cos_half_angle)
+            if distance < 0.0:
                 continue
-            if occluding:
+            on_grid = row_inside and 0 <= col < cols
+            if occluding and on_grid:
+                # The bins of model.occlusion first: nearer than every wall of its bin, seen; beyond a wall
+                # that hides the whole bin, hidden; the exact test of model.visibility for the rest.
                 distance2 = distance * distance
-                near, beyond = shadows[
-                    :, pseudo_bin(across / (cx * heading_x + cy * heading_y + abs(across) + 1e-300), half_angle)
-                ]
+                near, beyond = shadows[:, pseudo_bin(across / (along + abs(across) + 1e-300), half_angle)]
                 if distance2 > near:
                     target_x, target_y = (col + 0.5) * cell, (row + 0.5) * cell
-                    if distance2 > beyond or hidden_by_teammates(teammates, ground.radius, x, y, target_x, target_y):
+                    if (
+                        distance2 > beyond
+                        or hidden_by_teammates(teammates, ground.radius, x, y, target_x, target_y)
+                        or segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell)
+                    ):
+                        # Hidden: it stays in S_Ω if the wedge holds it, and where the cheap cone test
+                        # settles that, the arctangent is not taken (the cell has no ability to weigh).
+                        if (
+                            along >= distance * cos_half_angle + SURELY_IN_CONE
+                            or bearing_offset(distance, along, across) <= half_angle
+                        ):
+                            cells_in_wedge += 1
                         continue
-                    if segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell):
-                        continue
+            offset = bearing_offset(distance, along, across)
+            if offset > half_angle:
+                continue
+            cells_in_wedge += 1
+            if not on_grid:
+                continue
             ability = sensing_ability(distance, offset, sensing_range, half_angle, alpha_max)
             ticks[row - clip_row0, col - clip_col0] = int(ability * tick_scale + 0.5)
             lack = lack_of_coverage(coverage[row, col], target_ticks)

@@ -110,10 +110,12 @@ def uncovered_to_look_at(
     # whole square keeping the strictly nearer. Each wall square a line was found to cross hides, for sure,
     # every cell beyond its farthest corner on the bearings strictly inside its span (their segments cross
     # its inside): kept per bearing bin, so a robot among walls tests a few lines, not every cell within R.
+    # Gaps are compared squared: no square root per cell.
     beyond = np.full(LOOK_BINS, np.inf)
-    best, best_index, best_x, best_y = sensing_range, rows * cols, math.nan, math.nan
+    reach2 = sensing_range * sensing_range
+    best2, best_index, best_x, best_y = reach2, rows * cols, math.nan, math.nan
     for ring in range(span + 1):
-        if (ring - 0.5) * cell > best:
+        if ring > 0 and ((ring - 0.5) * cell) ** 2 > best2:
             break
         for r in range(max(centre_row - ring, 0), min(centre_row + ring + 1, rows)):
             edge_row = r == centre_row - ring or r == centre_row + ring
@@ -122,26 +124,29 @@ def uncovered_to_look_at(
                 if c < 0 or c >= cols or coverage[r, c] >= target_ticks or occupied[r, c]:
                     continue
                 cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
-                gap = math.hypot(cx - x, cy - y)
+                dx, dy = cx - x, cy - y
+                gap2 = dx * dx + dy * dy
                 index = r * cols + c
-                if gap > best or (gap == best and index > best_index) or gap >= sensing_range:
+                if gap2 >= reach2 or gap2 > best2 or (gap2 == best2 and index > best_index):
                     continue
-                if gap > 0.0 and gap * gap > beyond[_look_bin(cx - x, cy - y)]:
+                if gap2 > 0.0 and gap2 > beyond[_look_bin(dx, dy)]:
                     continue  # (a robot on the cell's centre sees it: no bearing, nothing between)
                 wall_row, wall_col = first_occupied_crossed(occupied, x, y, cx, cy, cell)
                 if wall_row >= 0:
                     _shadow_behind(beyond, wall_col * cell - x, wall_row * cell - y, cell)
                     continue
                 if not hidden_by_teammates(hiding, ground.radius, x, y, cx, cy):
-                    best, best_index, best_x, best_y = gap, index, cx, cy
+                    best2, best_index, best_x, best_y = gap2, index, cx, cy
     return best_x, best_y
 
 
 LOOK_BINS = 720
 """Bearing bins of the look-at search's shadows (by the diamond angle: 180 a quadrant)."""
-ANGLE_SLACK = 1e-9
-"""How far inside a square's span, in radians, a bearing must lie to be called inside: far more than the
-rounding of an arctangent, so a line grazing the square's corner is never taken for one crossing it."""
+DIAMOND_SLACK = 1e-9
+"""How far inside a square's span, in diamond angle, a bearing must lie to be called inside: far more than
+the rounding of a diamond angle (~1e-16), so a line grazing the square's corner is never taken for one
+crossing it. (A diamond angle grows at most as fast as the bearing in radians: the slack is at least 1e-9
+radians.)"""
 
 
 @njit(cache=True)
@@ -162,10 +167,14 @@ def _look_bin(dx: float, dy: float) -> int:
 @njit(cache=True)
 def _shadow_behind(beyond: np.ndarray, left: float, bottom: float, cell: float) -> None:
     """Mark the bins wholly inside the angular span of the square with lower-left corner (left, bottom)
-    relative to the robot with the squared distance of its farthest corner."""
+    relative to the robot with the squared distance of its farthest corner.
+
+    The span is taken in diamond angle, which is monotone in the bearing, so its ends are its extreme
+    corners' diamond angles, measured from the centre's: a square that does not hold the robot spans less
+    than a half turn, 2 in diamond angle, so each corner lies within ±2 of the centre."""
     if square_gap2(left, bottom, cell) < 1e-12:
         return  # the robot on its edge: no span to speak of
-    centre = math.atan2(bottom + 0.5 * cell, left + 0.5 * cell)
+    centre = _diamond(left + 0.5 * cell, bottom + 0.5 * cell)
     low, high, farthest2 = math.inf, -math.inf, 0.0
     for corner_x, corner_y in (
         (left, bottom),
@@ -173,17 +182,18 @@ def _shadow_behind(beyond: np.ndarray, left: float, bottom: float, cell: float) 
         (left, bottom + cell),
         (left + cell, bottom + cell),
     ):
-        offset = math.atan2(corner_y, corner_x) - centre
-        offset = math.atan2(math.sin(offset), math.cos(offset))  # the square does not hold the robot: |offset| < π/2
+        offset = _diamond(corner_x, corner_y) - centre
+        if offset > 2.0:
+            offset -= 4.0
+        elif offset < -2.0:
+            offset += 4.0
         low, high = min(low, offset), max(high, offset)
         farthest2 = max(farthest2, corner_x * corner_x + corner_y * corner_y)
-    inner_low, inner_high = centre + low + ANGLE_SLACK, centre + high - ANGLE_SLACK
-    if inner_low >= inner_high:
+    start, end = centre + low + DIAMOND_SLACK, centre + high - DIAMOND_SLACK
+    if start >= end:
         return
-    start = _diamond(math.cos(inner_low), math.sin(inner_low))
-    end = _diamond(math.cos(inner_high), math.sin(inner_high))
-    if end < start:
-        end += 4.0  # across the +x axis
+    if start < 0.0:
+        start, end = start + 4.0, end + 4.0  # across the +x axis: bins counted on from the last
     first = math.floor(start * (LOOK_BINS / 4.0)) + 1
     last = math.floor(end * (LOOK_BINS / 4.0)) - 1
     for k in range(first, last + 1):

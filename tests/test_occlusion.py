@@ -5,11 +5,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from model.fixed_point import COVERAGE_SCALE
 from model.ground import NO_POSITIONS, Ground
+from model.occlusion import _square_span, _square_span_by_corners
 from model.sensing import sense_wedge
 from model.visibility import line_of_sight
 
@@ -32,11 +34,16 @@ def test_the_pruned_wedge_hides_exactly_what_the_rule_hides(seed, theta, radius)
     coverage = np.zeros((40, 40), dtype=np.int64)
     ground = Ground(occupied, ~occupied, radius, radius, radius, False, True, True, 20)
     blind = ground._replace(occlusion=False)
-    *_, row0, col0, seen = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, positions, 0)
-    *_, row0b, col0b, everything = sense_wedge(
+    e_seen, *_, row0, col0, seen = sense_wedge(
+        coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, positions, 0
+    )
+    e_everything, *_, row0b, col0b, everything = sense_wedge(
         coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, blind, NO_POSITIONS, 0
     )
     assert (row0, col0, seen.shape) == (row0b, col0b, everything.shape)
+    # e_Ω on a fresh map: the visible cells' lack over every cell of the wedge, hidden or off the grid
+    # (the pass counts a hidden cell without its arctangent where the cone's cheap test settles it).
+    assert e_seen * np.count_nonzero(everything) == pytest.approx(e_everything * np.count_nonzero(seen), rel=1e-12)
     others = positions[1:][np.hypot(*(positions[1:] - [x, y]).T) >= 2 * radius]  # overlapping bodies hide nothing
     for i, j in zip(*np.nonzero(everything), strict=True):
         visible = line_of_sight(occupied, x, y, (col0 + j + 0.5), (row0 + i + 0.5), 1.0, others, radius)
@@ -108,3 +115,20 @@ def test_a_diagonal_through_grid_corners_is_pruned_as_the_traversal_decides():
     for i, j in zip(*np.nonzero(everything), strict=True):
         visible = line_of_sight(occupied, x, y, (col0 + j + 0.5), (row0 + i + 0.5), 1.0, NO_POSITIONS, 0.0)
         assert seen[i, j] == (everything[i, j] if visible else 0)
+
+
+@settings(max_examples=300)
+@given(st.floats(-8.0, 8.0), st.floats(-8.0, 8.0), st.floats(-math.pi, math.pi), st.booleans())
+def test_a_square_seen_from_outside_spans_what_its_four_corners_span(left, bottom, theta, on_grid_lines):
+    """The span's ends taken from the two corners where the robot lies equal the corners' extremes (to
+    the last bits: corners on one bearing round apart), squares beside and behind the robot included."""
+    if on_grid_lines:
+        left, bottom = float(round(left)), float(round(bottom))
+    if left <= 0.0 <= left + 1.0 and bottom <= 0.0 <= bottom + 1.0:
+        return  # the robot on or in the square: only the corners' rule applies
+    heading_x, heading_y = math.cos(theta), math.sin(theta)
+    smallest, largest, farthest2, behind = _square_span(left, bottom, 1.0, heading_x, heading_y)
+    by_corners = _square_span_by_corners(left, bottom, 1.0, heading_x, heading_y)
+    assert (farthest2, behind) == by_corners[2:]
+    assert smallest == pytest.approx(by_corners[0], abs=1e-14)
+    assert largest == pytest.approx(by_corners[1], abs=1e-14)
