@@ -97,7 +97,10 @@ def command_safety_study(args: argparse.Namespace) -> int:
     unknown = sorted(set(maps) - set(MAPS))
     if unknown:
         raise ScenarioError(f"--maps: expected names among {', '.join(MAPS)} (or none), got {unknown[0]!r}")
-    run_study(args.runs, parse_team_range(args.teams), Path(args.out), args.workers, maps)
+    teams = [] if args.teams == "none" else parse_team_range(args.teams)
+    if not teams and not maps:
+        raise ScenarioError("--teams none with --maps none: nothing to run")
+    run_study(args.runs, teams, Path(args.out), args.workers, maps)
     print(f"safety study written to {args.out}/safety.md")
     return EXIT_OK
 
@@ -229,7 +232,7 @@ def _add_in_process_commands(commands: argparse._SubParsersAction) -> None:
     safety = commands.add_parser("safety-study", help="the safety filter on and off, same seeds (issue 12)")
     safety.add_argument("--out", required=True, help="output directory (docs/safety holds the committed one)")
     safety.add_argument("--runs", type=int, default=100, help="seeded runs per case (default 100)")
-    safety.add_argument("--teams", default="1-30", help="team sizes on the paper's domain (default 1-30)")
+    safety.add_argument("--teams", default="1-30", help="team sizes on the paper's domain (default 1-30, or none)")
     safety.add_argument("--maps", default="warehouse,office,field", help="shipped maps, N = 4 and 10 (or none)")
     safety.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
     safety.set_defaults(handler=command_safety_study)

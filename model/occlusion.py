@@ -10,8 +10,9 @@ its part in front, up to ±90° on its side: a segment to a cell in front never 
 square with no corner in front is left out, unless the robot stands on its edge: then it spans every bin), and,
 for the bins wholly inside a
 square's span, the distance of its farthest corner: a ray there crosses the square's inside, so a cell
-beyond is hidden without a traversal. Squares farther than R, and squares whose four neighbours are
-occupied (a segment reaches one only through a neighbour, unless it ends there), are left out. A cell nearer than its bin's distance
+beyond is hidden without a traversal. Squares farther than R, squares wholly past the line of an edge of
+the wedge (:func:`_past_an_edge`), and squares whose four neighbours are occupied (a segment reaches one
+only through a neighbour, unless it ends there), are left out. A cell nearer than its bin's distance
 cannot be hidden by a wall; the others get the exact traversal. (A segment from p to c stays in the
 window grown to the robot's own cell, which holds both, so squares outside it cannot hide anything.) For teammates: those whose
 disk can reach the wedge, each tested exactly.
@@ -57,9 +58,7 @@ def wall_shadows(
     rows, cols = ground.occupied.shape
     heading_x, heading_y = math.cos(theta), math.sin(theta)
     reach2 = sensing_range * sensing_range
-    # A square wholly on the far side of the line of an edge of the wedge (bearings F to F + 180°, or the
-    # mirror) holds no bearing of the wedge: its circumscribed circle clear of that line is enough to tell.
-    cos_half_angle, sin_half_angle, circumradius = math.cos(half_angle), math.sin(half_angle), 0.7072 * cell
+    cos_half_angle, sin_half_angle = math.cos(half_angle), math.sin(half_angle)
     # The window of the wedge's cells and the robot's own cell: a segment between them stays inside.
     row0, row1 = min(row0, math.floor(y / cell)), max(row1, math.floor(y / cell) + 1)
     col0, col1 = min(col0, math.floor(x / cell)), max(col1, math.floor(x / cell) + 1)
@@ -69,13 +68,10 @@ def wall_shadows(
                 continue  # a segment reaches a cell inside a wall only through the wall cells around it
             left, bottom = col * cell - x, row * cell - y
             nearest2 = square_gap2(left, bottom, cell)
-            centre_x, centre_y = left + 0.5 * cell, bottom + 0.5 * cell
-            beside = abs(heading_x * centre_y - heading_y * centre_x) * cos_half_angle
-            if (
-                nearest2 > reach2
-                or beside - (centre_x * heading_x + centre_y * heading_y) * sin_half_angle > circumradius
+            if nearest2 > reach2 or _past_an_edge(
+                left, bottom, cell, heading_x, heading_y, cos_half_angle, sin_half_angle
             ):
-                continue  # farther than R, or wholly past an edge of the wedge (its circle clear of the edge's line)
+                continue  # farther than R, or no bearing of it in the wedge
             smallest, largest, farthest2, behind = _square_span(left, bottom, cell, heading_x, heading_y)
             if nearest2 == 0.0:
                 # The robot stands on its edge: the traversal's tie rules (a segment from a grid corner)
@@ -98,6 +94,21 @@ def wall_shadows(
             ):
                 shadows[1, k] = min(shadows[1, k], farthest2)
     return shadows
+
+
+@njit(cache=True)
+def _past_an_edge(
+    left: float, bottom: float, cell: float, heading_x: float, heading_y: float, cos_half: float, sin_half: float
+) -> bool:
+    """Whether the square with lower-left corner (left, bottom), relative to the robot, lies wholly past the
+    line of the wedge's edge on its side, by its circumscribed circle (radius 0.7072 cell, a little over
+    √2/2 for rounding): the line through the robot at bearing ±F, the side away from the heading. Such a
+    square's bearings, seen from the robot, all lie beyond ±F (with F ≤ 90°, the far side of the line holds
+    bearings F to F + 180°; with F > 90°, a circle centred past F and clear of the line spans bearings
+    past F only), so no segment to a cell of the wedge enters it."""
+    centre_x, centre_y = left + 0.5 * cell, bottom + 0.5 * cell
+    beside = abs(heading_x * centre_y - heading_y * centre_x) * cos_half
+    return beside - (centre_x * heading_x + centre_y * heading_y) * sin_half > 0.7072 * cell
 
 
 @njit(cache=True)
@@ -231,14 +242,16 @@ def add_teammate_shadows(
     it spans nothing. (``teammates`` are never within 2r, so the robot is never inside a disk.)
 
     The tangents are the direction to the centre turned by ±asin(r / gap), taken as rotations in the
-    robot's frame (along the heading, across to its left): no angle is computed."""
+    robot's frame (along the heading, across to its left): no angle is computed. This needs gap ≥ √2·r
+    (tangents at most 45° off the centre's bearing, so a disk with a tangent behind on the wrong side lies
+    wholly behind); :func:`teammates_in_view` gives only teammates at gap ≥ 2r."""
     heading_x, heading_y = math.cos(theta), math.sin(theta)
     for k in range(teammates.shape[0]):
         dx, dy = teammates[k, 0] - x, teammates[k, 1] - y
         gap = math.hypot(dx, dy)
         nearest2 = max(gap - radius, 0.0) ** 2
         along, across = (dx * heading_x + dy * heading_y) / gap, (heading_x * dy - heading_y * dx) / gap
-        sine = min(radius / gap, 1.0)
+        sine = radius / gap
         cosine = math.sqrt(1.0 - sine * sine)
         low_along, low_across = along * cosine + across * sine, across * cosine - along * sine  # clockwise
         high_along, high_across = along * cosine - across * sine, across * cosine + along * sine

@@ -58,7 +58,7 @@ def wedge_reach(
 ) -> tuple[float, float, float]:
     """(r, along, across) of a point at (cx, cy) from the robot when it lies within R and passes the cone's
     cheap test (cos θ_ix ≥ cos F, to rounding), else r = −1: the support of eq. 2 before the exact test of
-    :func:`bearing_offset`. ``across`` > 0: the point is left of the heading."""
+    :func:`offset_from_heading`. ``across`` > 0: the point is left of the heading."""
     distance = math.sqrt(cx * cx + cy * cy)
     if distance > sensing_range:
         return -1.0, 0.0, 0.0
@@ -70,14 +70,15 @@ def wedge_reach(
 
 
 @njit(cache=True)
-def bearing_offset(distance: float, along: float, across: float) -> float:
+def offset_from_heading(distance: float, along: float, across: float) -> float:
     """θ_ix = |θ_i − θ_x| of a point (0 at the robot itself): the wedge holds it when θ_ix ≤ F."""
     return abs(math.atan2(across, along)) if distance > 0.0 else 0.0
 
 
 SURELY_IN_CONE = 1e-9
-"""How far past the cheap cone test (along ≥ r·cos F) a point must lie for the wedge to hold it surely,
-without the arctangent of the exact test: far more than the rounding of either."""
+"""How far past the cone's cheap test a point must lie, in cos θ_ix (along ≥ r·(cos F + this)), for the
+wedge to hold it surely, without the arctangent of the exact test: far more than the rounding of either,
+at any scale."""
 
 
 @njit(cache=True)
@@ -109,11 +110,36 @@ def sense_wedge(
     rows, cols = coverage.shape
     row0, row1, col0, col1 = wedge_cell_range(x, y, theta, sensing_range, half_angle, cell)
     clip_row0, clip_col0, ticks = _delta_window(rows, cols, row0, row1, col0, col1)
+    shadows = wall_shadows(ground, x, y, theta, half_angle, sensing_range, cell, row0, row1, col0, col1)
+    teammates = teammates_in_view(ground, positions, me, x, y, sensing_range)
+    add_teammate_shadows(shadows, teammates, ground.radius, x, y, theta, half_angle)
+    cells_in_wedge, lack_sum, w_left, w_right = _sweep(
+        coverage, target_ticks, (x, y, theta), (sensing_range, half_angle, alpha_max, dt, cell), ground, teammates,
+        shadows, ticks, (row0, row1, col0, col1), (clip_row0, clip_col0),
+    )  # fmt: skip
+    e_omega = lack_sum / cells_in_wedge if cells_in_wedge > 0 else 0.0
+    return e_omega, w_left, w_right, clip_row0, clip_col0, ticks
+
+
+@njit(cache=True)
+def _sweep(
+    coverage: np.ndarray,
+    target_ticks: int,
+    pose: tuple[float, float, float],
+    sensor: tuple[float, float, float, float, float],
+    ground: Ground,
+    teammates: np.ndarray,
+    shadows: np.ndarray,
+    ticks: np.ndarray,
+    window: tuple[int, int, int, int],
+    clip: tuple[int, int],
+) -> tuple[int, float, float, float]:
+    """:func:`sense_wedge`'s pass over ``window`` (row0, row1, col0, col1) from ``pose`` with ``sensor`` (R, F,
+    α_M, dt, cell): writes ``ticks`` (top-left cell ``clip``); (cells in the wedge, Σ lack, w_left, w_right)."""
+    (x, y, theta), (sensing_range, half_angle, alpha_max, dt, cell) = pose, sensor
+    (rows, cols), (row0, row1, col0, col1), (clip_row0, clip_col0) = coverage.shape, window, clip
     heading_x, heading_y, cos_half_angle = math.cos(theta), math.sin(theta), math.cos(half_angle)
     tick_scale, area_weight = dt * COVERAGE_SCALE, cell * cell / (sensing_range * half_angle)
-    shadows = wall_shadows(ground, x, y, theta, half_angle, sensing_range, cell, row0, row1, col0, col1)
-    teammates, occluding = teammates_in_view(ground, positions, me, x, y, sensing_range), ground.occlusion
-    add_teammate_shadows(shadows, teammates, ground.radius, x, y, theta, half_angle)
     cells_in_wedge, lack_sum, w_left, w_right = 0, 0.0, 0.0, 0.0
     for row in range(row0, row1):
         cy = (row + 0.5) * cell - y
@@ -124,27 +150,22 @@ def sense_wedge(
             if distance < 0.0:
                 continue
             on_grid = row_inside and 0 <= col < cols
-            if occluding and on_grid:
+            if ground.occlusion and on_grid:
                 # The bins of model.occlusion first: nearer than every wall of its bin, seen; beyond a wall
                 # that hides the whole bin, hidden; the exact test of model.visibility for the rest.
                 distance2 = distance * distance
                 near, beyond = shadows[:, pseudo_bin(across / (along + abs(across) + 1e-300), half_angle)]
-                if distance2 > near:
-                    target_x, target_y = (col + 0.5) * cell, (row + 0.5) * cell
-                    if (
-                        distance2 > beyond
-                        or hidden_by_teammates(teammates, ground.radius, x, y, target_x, target_y)
-                        or segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell)
-                    ):
-                        # Hidden: it stays in S_Ω if the wedge holds it, and where the cheap cone test
-                        # settles that, the arctangent is not taken (the cell has no ability to weigh).
-                        if (
-                            along >= distance * cos_half_angle + SURELY_IN_CONE
-                            or bearing_offset(distance, along, across) <= half_angle
-                        ):
-                            cells_in_wedge += 1
-                        continue
-            offset = bearing_offset(distance, along, across)
+                target_x, target_y = (col + 0.5) * cell, (row + 0.5) * cell
+                if distance2 > near and (
+                    distance2 > beyond
+                    or hidden_by_teammates(teammates, ground.radius, x, y, target_x, target_y)
+                    or segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell)
+                ):
+                    # Hidden, yet in S_Ω if in the wedge: no arctangent where the cone's cheap test settles it.
+                    surely = along >= distance * (cos_half_angle + SURELY_IN_CONE)
+                    cells_in_wedge += surely or offset_from_heading(distance, along, across) <= half_angle
+                    continue
+            offset = offset_from_heading(distance, along, across)
             if offset > half_angle:
                 continue
             cells_in_wedge += 1
@@ -160,5 +181,4 @@ def sense_wedge(
                     w_left += weight
                 elif across < 0.0:
                     w_right += weight
-    e_omega = lack_sum / cells_in_wedge if cells_in_wedge > 0 else 0.0
-    return e_omega, w_left, w_right, clip_row0, clip_col0, ticks
+    return cells_in_wedge, lack_sum, w_left, w_right

@@ -110,7 +110,8 @@ def uncovered_to_look_at(
     # whole square keeping the strictly nearer. Each wall square a line was found to cross hides, for sure,
     # every cell beyond its farthest corner on the bearings strictly inside its span (their segments cross
     # its inside): kept per bearing bin, so a robot among walls tests a few lines, not every cell within R.
-    # Gaps are compared squared: no square root per cell.
+    # Gaps are compared squared, as rounded (no square root per cell): of two cells at the same true
+    # distance, the smaller rounded square is the nearer, and of equal ones the first in row-major order.
     beyond = np.full(LOOK_BINS, np.inf)
     reach2 = sensing_range * sensing_range
     best2, best_index, best_x, best_y = reach2, rows * cols, math.nan, math.nan

@@ -60,6 +60,13 @@ def test_bad_team_range_is_a_clear_error(tmp_path):
     assert "--teams: expected sizes like 1-30" in done.stderr
 
 
+def test_a_safety_study_of_nothing_is_a_clear_error(tmp_path):
+    done = anicov("safety-study", "--out", str(tmp_path), "--teams", "none", "--maps", "none")
+    assert done.returncode == 2
+    assert "--teams none with --maps none: nothing to run" in done.stderr
+    assert not (tmp_path / "safety.md").exists()
+
+
 def test_reproduce_small_writes_json_table_and_figures(tmp_path):
     done = anicov("reproduce", "--out", str(tmp_path), "--runs", "2", "--teams", "3,4", "--workers", "2")
     assert done.returncode == 0, done.stderr

@@ -70,15 +70,16 @@ def nearest_in_sight_by_scan(coverage, ground, teammates, x, y, objective_x, obj
     centre = ((col + 0.5) * cell, (row + 0.5) * cell)
     if coverage[row, col] < TARGET and line_of_sight(ground.occupied, x, y, *centre, cell, hiding, ground.radius):
         return centre
-    best, found = reach, (math.nan, math.nan)
+    best2, found = reach * reach, (math.nan, math.nan)
     for r in range(rows):
         for c in range(cols):
             if coverage[r, c] >= TARGET or ground.occupied[r, c]:
                 continue
             point = ((c + 0.5) * cell, (r + 0.5) * cell)
-            gap = math.hypot(point[0] - x, point[1] - y)
-            if gap < best and line_of_sight(ground.occupied, x, y, *point, cell, hiding, ground.radius):
-                best, found = gap, point
+            dx, dy = point[0] - x, point[1] - y
+            gap2 = dx * dx + dy * dy  # squared as the search rounds it: ties go to the first in row-major order
+            if gap2 < best2 and line_of_sight(ground.occupied, x, y, *point, cell, hiding, ground.radius):
+                best2, found = gap2, point
     return found
 
 
