@@ -135,8 +135,12 @@ class LanePlanner:
     def _left_to_cover(self, lack: np.ndarray, route: Route) -> bool:
         """Whether an uncovered cell lies within half a spacing of the route from its progress on."""
         strip = np.zeros(lack.shape, dtype=np.uint8)
-        route.draw_ahead(strip, self.scenario.cell, max(1, round(self.spacing / self.scenario.cell)))
+        route.draw_ahead(strip, self.scenario.cell, self._strip_cells())
         return bool((lack[strip.astype(bool)] > 0.0).any())
+
+    def _strip_cells(self) -> int:
+        """The width, in cells, of the strip a route sweeps: a lane spacing, half of it each side."""
+        return max(1, round(self.spacing / self.scenario.cell))
 
     def _all(self, ids: list[int], positions: np.ndarray) -> np.ndarray:
         """Every robot's position at the first plan (a robot not among the members: the domain's centre)."""
@@ -170,7 +174,7 @@ class LanePlanner:
         what is left of it), so that a robot done early does not fly another's lanes before it."""
         claimed = np.zeros(lack.shape, dtype=np.uint8)
         cell = self.scenario.cell
-        width = max(1, round(self.spacing / cell))
+        width = self._strip_cells()
         for agent in ids:
             route = self.routes[agent]
             if route.cleanup or route.done():
