@@ -17,7 +17,7 @@ import numpy as np
 
 from anicov.engine import run_scenario
 from anicov.sweep import Sweep, read_done, run_sweep
-from model.metrics import coverage_distance, optimum_time, straight_pass_coverage, total_sensing_ability
+from model.metrics import optimum_time, pass_reach, straight_pass_coverage, total_sensing_ability
 from model.scenario import PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
 from model.zigzag import zigzag_pilots, zigzag_start_poses
 
@@ -112,8 +112,8 @@ def reproduce(
     report = {
         "scenario": base.to_dict(),
         "seed": seed,
-        "d100": coverage_distance(base.lambda_star, base.range, base.half_angle, base.alpha_max),
-        "d50": coverage_distance(base.lambda_star / 2, base.range, base.half_angle, base.alpha_max),
+        "d100": pass_reach(base),
+        "d50": pass_reach(base, 0.5),
         "total_ability": ability,
         "zigzag_time_1": zigzag["time"],
         "zigzag_path_1": zigzag["path"],

@@ -4,10 +4,14 @@ and the coverage profile of one straight pass (Fig. 7) with its d100 and d50."""
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from scipy import integrate, optimize
 
 from model.sensing import sensing_ability
+
+if TYPE_CHECKING:
+    from model.scenario import Scenario
 
 
 def total_sensing_ability(sensing_range: float, half_angle: float, alpha_max: float) -> float:
@@ -54,3 +58,8 @@ def coverage_distance(level: float, sensing_range: float, half_angle: float, alp
         sensing_range * math.sin(half_angle) - 1e-9,
         xtol=1e-12,
     )
+
+
+def pass_reach(scenario: Scenario, share: float = 1.0) -> float:
+    """:func:`coverage_distance` of the scenario's sensor at ``share`` of Λ*: d100 (1.0) or d50 (0.5)."""
+    return coverage_distance(scenario.lambda_star * share, scenario.range, scenario.half_angle, scenario.alpha_max)

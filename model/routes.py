@@ -24,7 +24,7 @@ import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment, minimize_scalar
 
-from model.metrics import coverage_distance, straight_pass_coverage
+from model.metrics import pass_reach, straight_pass_coverage
 from model.scenario import Scenario
 from model.zigzag import path_between, point_along
 
@@ -137,18 +137,13 @@ class Route:
         cv2.polylines(canvas, [np.round(line).astype(np.int32)], False, 1, thickness=width)
 
 
-def one_pass_reach(scenario: Scenario) -> float:
-    """d100: how far beside a straight pass at v = 1 its camera brings Λ* (model.metrics.coverage_distance)."""
-    return coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
-
-
 def spiral_path(scenario: Scenario, spacing: float) -> np.ndarray:
     """The one-robot sweep: a rectangular spiral inward, as a polyline (K, 2). Its outer ring lies d100
     inside the domain's edges; its rings are evenly spaced, at most ``spacing`` apart, so that the
     innermost one is at most d100 from the domain's centre line (one pass brings Λ* that far): a
     spiral whose last ring stopped short would leave its centre to slow passes after it."""
     width, height = scenario.domain
-    d100 = one_pass_reach(scenario)
+    d100 = pass_reach(scenario)
     return spiral_in(width, height, d100, spacing)
 
 
@@ -187,7 +182,7 @@ def spiral_variants(scenario: Scenario, spacing: float) -> list[np.ndarray]:
     way round): the same rings, flown inward, their starts in other places, each ending where the spiral
     does (on the innermost ring)."""
     width, height = scenario.domain
-    d100 = one_pass_reach(scenario)
+    d100 = pass_reach(scenario)
     along_x = spiral_in(width, height, d100, spacing)
     along_y = spiral_in(height, width, d100, spacing)[:, ::-1]  # the transposed rectangle's, transposed back
     variants = []

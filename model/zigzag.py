@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from model.geometry import wrap_angle
-from model.metrics import coverage_distance
+from model.metrics import pass_reach
 from model.scenario import Scenario
 
 HEADING_TOLERANCE = 1e-6
@@ -83,8 +83,7 @@ class WaypointPilot:
 
 def zigzag_pilots(scenario: Scenario) -> list[WaypointPilot]:
     """One waypoint pilot per agent, each sweeping a contiguous block of the Fig. 8 lanes."""
-    d100 = coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
-    d50 = coverage_distance(scenario.lambda_star / 2.0, scenario.range, scenario.half_angle, scenario.alpha_max)
+    d100, d50 = pass_reach(scenario), pass_reach(scenario, 0.5)
     lanes = lane_offsets(scenario.domain[1], d100, 2.0 * d50)
     pilots = []
     for first, block in split_lanes(lanes, scenario.agents):
@@ -116,8 +115,7 @@ def boustrophedon_pilots(scenario: Scenario, poses: np.ndarray) -> list[Waypoint
     it, so without the overlap the first R of each piece would be seen only in part."""
     from scipy.optimize import linear_sum_assignment
 
-    d100 = coverage_distance(scenario.lambda_star, scenario.range, scenario.half_angle, scenario.alpha_max)
-    d50 = coverage_distance(scenario.lambda_star / 2.0, scenario.range, scenario.half_angle, scenario.alpha_max)
+    d100, d50 = pass_reach(scenario), pass_reach(scenario, 0.5)
     lanes = lane_offsets(scenario.domain[1], d100, 2.0 * d50)
     path = zigzag_waypoints(scenario.domain[0], lanes, scenario.range, 0)
     along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])

@@ -4,7 +4,8 @@ import math
 
 import pytest
 
-from model.metrics import coverage_distance, optimum_time, straight_pass_coverage, total_sensing_ability
+from model.metrics import coverage_distance, optimum_time, pass_reach, straight_pass_coverage, total_sensing_ability
+from model.scenario import Scenario
 
 R, ALPHA = 20.0, 50.0
 F = math.radians(27.0)
@@ -23,6 +24,13 @@ def test_optimum_time_eq19():
 def test_d100_and_d50_match_paper_with_half_angle_27_degrees():
     assert coverage_distance(100.0, R, F, ALPHA) == pytest.approx(2.72, rel=0.01)
     assert coverage_distance(50.0, R, F, ALPHA) == pytest.approx(3.865, rel=0.01)
+
+
+def test_a_scenarios_pass_reach_is_its_sensors_d100_and_d50():
+    paper = Scenario()
+    assert pass_reach(paper) == coverage_distance(paper.lambda_star, paper.range, paper.half_angle, paper.alpha_max)
+    assert pass_reach(paper, 0.5) == pytest.approx(3.865, rel=0.01)
+    assert pass_reach(paper.with_overrides(range=10.0)) < pass_reach(paper)
 
 
 def test_half_angle_54_degrees_does_not_match_paper():
