@@ -107,11 +107,33 @@ def sense_wedge(
 ) -> tuple[float, float, float, int, int, np.ndarray]:
     """One pass over the wedge Ω_i (see the module): (e_Ω, w_left, w_right, row0, col0, ticks of eq. 3).
     ``positions`` (N, 2): every robot's (NaN: unknown; ``me``: this one), read only with occlusion."""
+    teammates = teammates_in_view(ground, positions, me, x, y, sensing_range)
+    return sense_wedge_among(
+        coverage, target_ticks, x, y, theta, sensing_range, half_angle, alpha_max, dt, cell, ground, teammates
+    )
+
+
+@njit(cache=True)
+def sense_wedge_among(
+    coverage: np.ndarray,
+    target_ticks: int,
+    x: float,
+    y: float,
+    theta: float,
+    sensing_range: float,
+    half_angle: float,
+    alpha_max: float,
+    dt: float,
+    cell: float,
+    ground: Ground,
+    teammates: np.ndarray,
+) -> tuple[float, float, float, int, int, np.ndarray]:
+    """:func:`sense_wedge` with the teammates that may hide part of the wedge already found
+    (:func:`model.occlusion.teammates_in_view`), for a caller that needs them too."""
     rows, cols = coverage.shape
     row0, row1, col0, col1 = wedge_cell_range(x, y, theta, sensing_range, half_angle, cell)
     clip_row0, clip_col0, ticks = _delta_window(rows, cols, row0, row1, col0, col1)
     shadows = wall_shadows(ground, x, y, theta, half_angle, sensing_range, cell, row0, row1, col0, col1)
-    teammates = teammates_in_view(ground, positions, me, x, y, sensing_range)
     add_teammate_shadows(shadows, teammates, ground.radius, x, y, theta, half_angle)
     cells_in_wedge, lack_sum, w_left, w_right = _sweep(
         coverage, target_ticks, (x, y, theta), (sensing_range, half_angle, alpha_max, dt, cell), ground, teammates,
@@ -153,8 +175,8 @@ def _sweep(
             if ground.occlusion and on_grid:
                 # The bins of model.occlusion first: nearer than every wall of its bin, seen; beyond a wall
                 # that hides the whole bin, hidden; the exact test of model.visibility for the rest.
-                distance2 = distance * distance
-                near, beyond = shadows[:, pseudo_bin(across / (along + abs(across) + 1e-300), half_angle)]
+                distance2, k = distance * distance, pseudo_bin(across / (along + abs(across) + 1e-300), half_angle)
+                near, beyond = shadows[0, k], shadows[1, k]
                 target_x, target_y = (col + 0.5) * cell, (row + 0.5) * cell
                 if distance2 > near and (
                     distance2 > beyond

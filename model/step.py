@@ -16,7 +16,7 @@ from model.control import combined_law, global_law, local_law, pursuit_law
 from model.dynamics import unicycle_step
 from model.ground import Ground
 from model.occlusion import teammates_in_view
-from model.sensing import sense_wedge
+from model.sensing import sense_wedge_among
 from model.wall_law import global_law_among_walls
 
 
@@ -45,11 +45,11 @@ def read_wedge(
     theta: float,
     law: LawParameters,
     ground: Ground,
-    positions: np.ndarray,
-    me: int,
+    teammates: np.ndarray,
 ) -> tuple[float, float, float, int, int, np.ndarray]:
-    """:func:`model.sensing.sense_wedge` with the law's sensor."""
-    return sense_wedge(
+    """:func:`model.sensing.sense_wedge` with the law's sensor, ``teammates`` those that may hide part of
+    the wedge (:func:`model.occlusion.teammates_in_view`)."""
+    return sense_wedge_among(
         coverage,
         law.target_ticks,
         x,
@@ -61,8 +61,7 @@ def read_wedge(
         law.dt,
         law.cell,
         ground,
-        positions,
-        me,
+        teammates,
     )
 
 
@@ -85,7 +84,8 @@ def decide_and_sense(
     On a terrain: ``field`` is the geodesic distance field of the objective (the global law follows the
     shortest free path when a wall hides it), ``positions`` (N, 2) every robot's position with this
     one's at row ``me`` (teammates hide cells); in the open world neither is read."""
-    e_omega, w_left, w_right, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, positions, me)
+    teammates = teammates_in_view(ground, positions, me, x, y, law.sensing_range)
+    e_omega, w_left, w_right, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, teammates)
     if law.pursuit:
         v, omega = pursuit_law(x, y, theta, objective_x, objective_y, law.k_v, law.k_omega, law.dt)
         return v, omega, e_omega, row0, col0, ticks
@@ -106,7 +106,7 @@ def decide_and_sense(
             law.literal_heading,
             ground,
             field,
-            teammates_in_view(ground, positions, me, x, y, law.sensing_range),
+            teammates,
         )
     v, omega = combined_law(
         theta, e_omega, u_loc, theta_loc, u_glo, theta_glo, law.beta, law.k_v, law.k_omega, law.literal_omega
@@ -150,7 +150,8 @@ def sense_only(
     me: int,
 ) -> tuple[int, int, np.ndarray]:
     """The delta window of an agent whose velocities come from elsewhere (the zig-zag pilot)."""
-    _, _, _, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, positions, me)
+    teammates = teammates_in_view(ground, positions, me, x, y, law.sensing_range)
+    _, _, _, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, teammates)
     return row0, col0, ticks
 
 

@@ -102,43 +102,81 @@ def uncovered_to_look_at(
     centre_x, centre_y = (col + 0.5) * cell, (row + 0.5) * cell
     if coverage[row, col] < target_ticks and _in_clear_sight(ground, teammates, x, y, centre_x, centre_y, cell):
         return centre_x, centre_y
-    span = math.ceil(sensing_range / cell)
-    centre_row, centre_col = math.floor(y / cell), math.floor(x / cell)
     hiding = teammates if ground.occlusion else teammates[:0]
-    # Ring by ring outward (Chebyshev rings round the robot's cell), until no cell of the next ring can
-    # be nearer than the best found; of equal gaps the first in row-major order wins, as in a scan of the
-    # whole square keeping the strictly nearer. Each wall square a line was found to cross hides, for sure,
-    # every cell beyond its farthest corner on the bearings strictly inside its span (their segments cross
-    # its inside): kept per bearing bin, so a robot among walls tests a few lines, not every cell within R.
+    return _nearest_uncovered_in_sight(
+        coverage, target_ticks, occupied, hiding, ground.radius, x, y, sensing_range, cell
+    )
+
+
+@njit(cache=True)
+def _nearest_uncovered_in_sight(
+    coverage: np.ndarray,
+    target_ticks: int,
+    occupied: np.ndarray,
+    hiding: np.ndarray,
+    radius: float,
+    x: float,
+    y: float,
+    sensing_range: float,
+    cell: float,
+) -> tuple[float, float]:
+    """:func:`uncovered_to_look_at`'s search beyond the objective's cell: the centre of the nearest uncovered
+    free cell within R of (x, y) that no wall and no disk of ``hiding`` hides; (NaN, NaN) if none."""
+    rows, cols = coverage.shape
+    centre_row, centre_col = math.floor(y / cell), math.floor(x / cell)
+    # Ring by ring outward (Chebyshev rings round the robot's cell), a ring's four sides each as one run of
+    # cells, until no cell of the next ring can be nearer than the best found; a side whose cells are all
+    # farther along one axis than the best is skipped. The nearest wins, and of equal gaps the first in
+    # row-major order: the comparison takes both, so the order of the scan does not matter.
+    # Each wall square a line was found to cross hides, for sure, every cell beyond its farthest corner
+    # on the bearings strictly inside its span (their segments cross its inside): kept per bearing bin, so
+    # a robot among walls tests a few lines, not every cell within R.
     # Gaps are compared squared, as rounded (no square root per cell): of two cells at the same true
     # distance, the smaller rounded square is the nearer, and of equal ones the first in row-major order.
     beyond = np.full(LOOK_BINS, np.inf)
     reach2 = sensing_range * sensing_range
     best2, best_index, best_x, best_y = reach2, rows * cols, math.nan, math.nan
-    for ring in range(span + 1):
+    for ring in range(math.ceil(sensing_range / cell) + 1):
         if ring > 0 and ((ring - 0.5) * cell) ** 2 > best2:
             break
-        for r in range(max(centre_row - ring, 0), min(centre_row + ring + 1, rows)):
-            edge_row = r == centre_row - ring or r == centre_row + ring
-            step = 1 if edge_row else 2 * ring
-            for c in range(centre_col - ring, centre_col + ring + 1, max(step, 1)):
-                if c < 0 or c >= cols or coverage[r, c] >= target_ticks or occupied[r, c]:
-                    continue
-                cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
-                dx, dy = cx - x, cy - y
-                gap2 = dx * dx + dy * dy
-                index = r * cols + c
-                if gap2 >= reach2 or gap2 > best2 or (gap2 == best2 and index > best_index):
-                    continue
-                if gap2 > 0.0 and gap2 > beyond[_look_bin(dx, dy)]:
-                    continue  # (a robot on the cell's centre sees it: no bearing, nothing between)
-                wall_row, wall_col = first_occupied_crossed(occupied, x, y, cx, cy, cell)
-                if wall_row >= 0:
-                    _shadow_behind(beyond, wall_col * cell - x, wall_row * cell - y, cell)
-                    continue
-                if not hidden_by_teammates(hiding, ground.radius, x, y, cx, cy):
-                    best2, best_index, best_x, best_y = gap2, index, cx, cy
+        for side in range(4 if ring > 0 else 1):
+            r, c, d_row, d_col, count, axis_gap = _ring_side(ring, side, centre_row, centre_col, rows, cols, x, y, cell)
+            if axis_gap * axis_gap > best2:
+                continue  # (a cell's rounded squared gap is at least its rounded squared axis gap)
+            for _ in range(count):
+                if coverage[r, c] < target_ticks and not occupied[r, c]:
+                    cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
+                    dx, dy = cx - x, cy - y
+                    gap2 = dx * dx + dy * dy
+                    index = r * cols + c
+                    if gap2 < reach2 and (gap2 < best2 or (gap2 == best2 and index < best_index)):
+                        # (A robot on the cell's centre sees it: no bearing, nothing between.)
+                        if gap2 == 0.0 or gap2 <= beyond[_look_bin(dx, dy)]:
+                            wall_row, wall_col = first_occupied_crossed(occupied, x, y, cx, cy, cell)
+                            if wall_row >= 0:
+                                _shadow_behind(beyond, wall_col * cell - x, wall_row * cell - y, cell)
+                            elif not hidden_by_teammates(hiding, radius, x, y, cx, cy):
+                                best2, best_index, best_x, best_y = gap2, index, cx, cy
+                r, c = r + d_row, c + d_col
     return best_x, best_y
+
+
+@njit(cache=True)
+def _ring_side(
+    ring: int, side: int, centre_row: int, centre_col: int, rows: int, cols: int, x: float, y: float, cell: float
+) -> tuple[int, int, int, int, int, float]:
+    """The run of grid cells on one side of the Chebyshev ring ``ring`` round cell (centre_row, centre_col):
+    (first row, first col, row step, col step, count, the side's gap from (x, y) across it). Sides 0 and 1
+    are the bottom and top rows whole, 2 and 3 the left and right columns between them."""
+    if side < 2:
+        row = centre_row - ring if side == 0 else centre_row + ring
+        first_col = max(centre_col - ring, 0)
+        count = min(centre_col + ring, cols - 1) - first_col + 1 if 0 <= row < rows else 0
+        return row, first_col, 0, 1, count, (row + 0.5) * cell - y
+    col = centre_col - ring if side == 2 else centre_col + ring
+    first_row = max(centre_row - ring + 1, 0)
+    count = min(centre_row + ring - 1, rows - 1) - first_row + 1 if 0 <= col < cols else 0
+    return first_row, col, 1, 0, count, (col + 0.5) * cell - x
 
 
 LOOK_BINS = 720

@@ -9,6 +9,7 @@ import msgpack
 import numpy as np
 import pytest
 
+from model.occlusion import teammates_in_view
 from model.parameters import coverage_map_of, law_parameters
 from model.scenario import PAPER_SCENARIO, load_scenario
 from model.step import read_wedge
@@ -35,7 +36,8 @@ def sensed_deltas(scenario, count: int, seed: int):
     for step in range(count):
         pose = (rng.uniform(0, width), rng.uniform(0, height), rng.uniform(-math.pi, math.pi))
         positions = np.array([pose[:2], (pose[0] + rng.uniform(-6, 6), pose[1] + rng.uniform(-6, 6))])
-        *_, row0, col0, ticks = read_wedge(grid.coverage, *pose, law, ground, positions, 0)
+        teammates = teammates_in_view(ground, positions, 0, pose[0], pose[1], law.sensing_range)
+        *_, row0, col0, ticks = read_wedge(grid.coverage, *pose, law, ground, teammates)
         yield pose, MapDelta(1, step, row0, col0, ticks)
 
 
