@@ -200,16 +200,17 @@ def malformed_payloads(total: int, seed: int = 7) -> list[bytes]:
 
 
 def test_fuzzed_payloads_on_every_key_are_rejected_and_the_run_is_untouched(tmp_path):
-    fuzz_a_running_team(tmp_path, domain=[30.0, 30.0], at_least=10_500, at_most=70_000)
+    fuzz_a_running_team(tmp_path, domain=[30.0, 30.0], payloads=70_000)
 
 
-def fuzz_a_running_team(tmp_path, domain: list[float], at_least: int, at_most: int) -> None:
-    """Publish malformed payloads on every key a 2-agent team listens to, round-robin, from the
-    agents' start until the run ends (at least ``at_least``, at most ``at_most``)."""
+def fuzz_a_running_team(tmp_path, domain: list[float], payloads: int) -> None:
+    """Publish ``payloads`` malformed payloads on every key a 2-agent team listens to, round-robin, from
+    the agents' start, while the run goes on: the run must outlast them, or the last ones would go out
+    as the processes close and could not all be counted (the test says so, rather than count them)."""
     config = write_scenario(tmp_path / "s.toml", domain=domain, agents=2, seed=9)
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
     assert engine.returncode == 0
-    payloads = malformed_payloads(4000)
+    distinct = malformed_payloads(4000)
     keys = TeamKeys(unique_team())
     targets = [
         keys.agent_step(0),
@@ -227,14 +228,15 @@ def fuzz_a_running_team(tmp_path, domain: list[float], at_least: int, at_most: i
             publishers = [
                 session.declare_publisher(key, congestion_control=zenoh.CongestionControl.BLOCK) for key in targets
             ]
-            while sent < at_least or (process.poll() is None and sent < at_most):
+            while sent < payloads and process.poll() is None:
                 for publisher in publishers:
-                    publisher.put(payloads[sent % len(payloads)])
+                    publisher.put(distinct[sent % len(distinct)])
                     sent += 1
-                if process.poll() is not None:
-                    break
-        stdout, stderr = process.communicate(timeout=300)
-    assert sent >= at_least
+            outlasted = process.poll() is None
+            # The session stays open until the team exits: closed at once, it could drop what its queue
+            # still held (2026-12-03: 260 payloads a key reached nobody when the fuzzer closed at its cap).
+            stdout, stderr = process.communicate(timeout=300)
+    assert outlasted, f"the run ended after {sent} of {payloads} payloads: give the fuzz a longer run"
     assert process.returncode == 0, stderr + stdout
     # The map, the trajectories, everything equals the run without the noise.
     for name in ("trajectory.csv", "summary.json"):
@@ -253,7 +255,7 @@ def fuzz_a_running_team(tmp_path, domain: list[float], at_least: int, at_most: i
         json.dumps(
             {
                 "sent": sent,
-                "distinct": len(payloads),
+                "distinct": len(distinct),
                 "coordinator": counts,
                 "logger": logger_counts,
                 "agents": agent_counts,
