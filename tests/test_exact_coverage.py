@@ -23,7 +23,7 @@ def float_and_exact(scenario, poses):
     grid = coverage_map_of(scenario)
     law, ground, kernel = law_parameters(scenario, grid), world_of(scenario).ground, exact_kernel_of(scenario)
     for x, y, theta in poses:
-        *_, row0, col0, ticks = read_wedge(grid.coverage, x, y, theta, law, ground, np.zeros((1, 2)), 0)
+        *_, row0, col0, ticks = read_wedge(grid.coverage, x, y, theta, law, ground, np.zeros((0, 2)))  # no teammates
         exact_row0, exact_col0, exact = event_ticks(kernel, x, y, theta)
         float_map, exact_map = np.zeros(grid.shape, np.int64), np.zeros(grid.shape, np.int64)
         float_map[row0 : row0 + ticks.shape[0], col0 : col0 + ticks.shape[1]] = ticks
