@@ -187,6 +187,12 @@ def hypothesis_payloads(count: int) -> list[bytes]:
     return found
 
 
+def run_ended(logs) -> bool:
+    """Whether the coordinator has logged the end of its run (coordinator.ending.announce_end)."""
+    log = logs / "coordinator.log"
+    return log.exists() and re.search(r"run (complete|incomplete) after", log.read_text()) is not None
+
+
 def malformed_payloads(total: int, seed: int = 7) -> list[bytes]:
     """Random bytes, mutated valid messages and hypothesis-made msgpack maps; all rejected by decode."""
     rng = random.Random(seed)
@@ -219,6 +225,7 @@ def fuzz_a_running_team(tmp_path, domain: list[float], payloads: int) -> None:
         keys.go,
         keys.control,
     ]
+    assert payloads % len(targets) == 0  # sent in rounds, one on each key
     port = free_port()
     out = tmp_path / "team"
     sent = 0
@@ -232,12 +239,14 @@ def fuzz_a_running_team(tmp_path, domain: list[float], payloads: int) -> None:
                 for publisher in publishers:
                     publisher.put(distinct[sent % len(distinct)])
                     sent += 1
-            outlasted = process.poll() is None
+            # The run, not only the launcher (which writes the run's files after it): the coordinator logs
+            # the end as it announces it, and its subscribers close as they hear it.
+            outlasted = process.poll() is None and not run_ended(out / "logs")
             # The session stays open until the team exits: closed at once, it could drop what its queue
             # still held (2026-12-03: 260 payloads a key reached nobody when the fuzzer closed at its cap).
             stdout, stderr = process.communicate(timeout=300)
-    assert outlasted, f"the run ended after {sent} of {payloads} payloads: give the fuzz a longer run"
     assert process.returncode == 0, stderr + stdout
+    assert outlasted, f"the run ended after {sent} of {payloads} payloads: give the fuzz a longer run"
     # The map, the trajectories, everything equals the run without the noise.
     for name in ("trajectory.csv", "summary.json"):
         assert (tmp_path / "engine" / name).read_bytes() == (out / name).read_bytes(), name
