@@ -252,12 +252,12 @@ def wait_for_peers(bus: Bus, stop: StopFlag, parent: int) -> bool:
     mine = digest_of(node.scenario)
     deadline = time.monotonic() + PEERS_TIMEOUT
     found: dict = {}
+    logger_ready = not node.options.await_logger
     while not stop.stopped:
         found = peer_digests(bus.session, node.keys, node.limits, timeout=HELLO_PERIOD)
         check_peers(mine, found, node.scenario)
-        logger_ready = not node.options.await_logger or logger_listens(
-            bus.session, node.keys.alive("logger"), timeout=HELLO_PERIOD
-        )
+        # A logger once seen is not asked again: the wait is for a logger to be listening when the run starts.
+        logger_ready = logger_ready or logger_listens(bus.session, node.keys.alive("logger"), timeout=HELLO_PERIOD)
         if len(found) == node.scenario.agents and logger_ready:
             return True
         if parent_is_gone(parent):
