@@ -25,13 +25,14 @@ def announce_end(bus: CoordinatorBus, stepping: Stepping) -> bytes | None:
     steps, completed, _ = stepping.outcome
     done = encode(RunControl("done", steps, completed, node.replica.map.domain_error()))
     bus.go_history.final = [done]  # an agent that lost the end of the run finds it here
-    bus.publish(bus.control, done)
+    # Logged before it is announced: a log without this line is a run whose processes all still listen.
     log.info(
         "run %s after %d steps (e_D = %.4f)",
         "complete" if completed else "incomplete",
         steps,
         node.replica.map.domain_error(),
     )
+    bus.publish(bus.control, done)
     return done
 
 
