@@ -20,7 +20,7 @@ from model.parameters import law_parameters, safety_parameters, starting_poses
 from model.safety import MEMORY_SIZE, PARKED, POSE_STALE, RAN_LATE, TEAMMATE, filter_command
 from model.safety import load_kernels as load_safety_kernels
 from model.scenario import Scenario
-from model.step import LawParameters, decide_and_sense, load_kernels
+from model.step import LawParameters, decide_and_sense, load_kernels, no_look
 from model.world import world_of
 from protocol.events import as_event
 from protocol.inbox import Inbox, Membership, Received
@@ -66,6 +66,7 @@ class AgentNode:
         self.kinds = np.full(scenario.agents, TEAMMATE, dtype=np.int64)  # PARKED once a teammate's process is gone
         self.safety = safety_parameters(scenario)
         self.safety_memory = np.zeros(MEMORY_SIZE, dtype=np.int64)  # the filter's deadlock state (model.safety)
+        self.look = no_look()  # the cell the law looked at in the step before (model.wall_law.cell_to_look_at)
         self.robot = robot or SimulatedUnicycle(tuple(starts[options.agent]), self.law, self.ground)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=1000 + options.agent)
         self.step = 0
@@ -262,7 +263,15 @@ class AgentNode:
         self.positions[me] = pose[:2]
         field = self.world.field(*self.objective) if self.ground.walls else NO_FIELD
         v, omega, e_omega, row0, col0, ticks = decide_and_sense(
-            self.replica.map.coverage, *pose, *self.objective, self.law, self.ground, field, self.positions, me
+            self.replica.map.coverage,
+            *pose,
+            *self.objective,
+            self.law,
+            self.ground,
+            field,
+            self.positions,
+            me,
+            self.look,
         )
         flags = 0
         if self.safety.enabled and late:

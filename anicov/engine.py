@@ -43,6 +43,7 @@ def advance_team(
     fields: np.ndarray,
     safety: SafetyParameters,
     memory: np.ndarray,
+    looks: np.ndarray,
     steps: int,
     uncovered: int,
     deficit: int,
@@ -55,21 +56,21 @@ def advance_team(
 
     ``fields[i]``: the distance field of agent i's objective (terrain only). With ``safety`` enabled every
     command passes through the filter (model.safety), from the poses at t_k, with ``memory`` (N, MEMORY_SIZE) its
-    deadlock state. Writes the per-step trace (TRACE_FIELDS), the filter's flags and e_D after each step;
-    returns (steps done, uncovered cells, deficit ticks).
+    deadlock state; ``looks`` (N, 2): what each robot looked at in the step before, kept between calls too.
+    Writes the per-step trace (TRACE_FIELDS), the filter's flags and e_D; returns (steps done, uncovered, deficit).
     """
     agents = poses.shape[0]
     positions = np.empty((agents, 2))
     fresh, teammates = np.zeros(agents), np.zeros(agents, dtype=np.int64)  # lockstep: every pose is t_k's
     for step in range(steps):
-        positions[:, 0] = poses[:, 0]
-        positions[:, 1] = poses[:, 1]
+        positions[:, :] = poses[:, :2]
         windows = List()
         for i in range(agents):
             x, y, theta = poses[i, 0], poses[i, 1], poses[i, 2]
             v, omega, e_omega, row0, col0, ticks = decide_and_sense(
-                coverage, x, y, theta, objectives[i, 0], objectives[i, 1], law, ground, fields[i], positions, i
-            )
+                coverage, x, y, theta, objectives[i, 0], objectives[i, 1], law, ground, fields[i], positions, i,
+                looks[i],
+            )  # fmt: skip
             windows.append((row0, col0, ticks))
             if safety.enabled:
                 v, omega, flags[step, i] = filter_command(
@@ -110,6 +111,7 @@ def run_scenario(
         return run_ranged(scenario, coverage_map, poses, record_trace, progress)
     law, world = law_parameters(scenario, coverage_map), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
+    looks = np.full((scenario.agents, 2), np.nan)  # nothing looked at yet (model.step.no_look)
     planner = planner_for(scenario)
     block = scenario.plan_steps
     agents = scenario.agents
@@ -131,7 +133,7 @@ def run_scenario(
         steps = min(block, scenario.max_steps - steps_done)
         done, coverage_map.uncovered_cells, coverage_map.deficit_ticks = advance_team(
             coverage_map.coverage, poses, objectives, law, world.ground, objective_fields(world, objectives),
-            safety, memory, steps, coverage_map.uncovered_cells, coverage_map.deficit_ticks,
+            safety, memory, looks, steps, coverage_map.uncovered_cells, coverage_map.deficit_ticks,
             coverage_map.target_ticks * coverage_map.counted_cells, scratch_trace, scratch_errors, scratch_flags,
         )  # fmt: skip
         flags.append(scratch_flags[:done].copy())

@@ -92,6 +92,7 @@ def run_ranged(
     """A team whose robots hear each other only within ``comm_range``, with central or local planning."""
     law, world = law_parameters(scenario, coverage_map), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
+    looks = np.full((scenario.agents, 2), np.nan)  # what each robot looked at in the step before
     agents = scenario.agents
     team = RadioTeam(coverage_map, agents)
     central = planner_for(scenario)
@@ -113,7 +114,9 @@ def run_ranged(
             fields = objective_fields(world, objectives)
             if record_trace:
                 plans.append(record_plan(scenario, central, step, objectives))
-        row, flag_row, windows = decide_team(team, poses, positions, objectives, fields, law, world, safety, memory)
+        row, flag_row, windows = decide_team(
+            team, poses, positions, objectives, fields, law, world, safety, memory, looks
+        )
         team.exchange(windows, in_contact)
         for i in range(agents):
             poses[i] = move(*poses[i], row[i, 3], row[i, 4], law, world.ground)
@@ -149,6 +152,7 @@ def decide_team(
     world: World,
     safety: SafetyParameters,
     memory: np.ndarray,
+    looks: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, list[Window]]:
     """Every robot's step k from its own replica: the trace row (TRACE_FIELDS), the filter's flags and
     the delta windows, as :func:`anicov.engine.advance_team` makes them from the one map."""
@@ -161,7 +165,7 @@ def decide_team(
         x, y, theta = poses[i]
         v, omega, e_omega, row0, col0, ticks = decide_and_sense(
             team.replicas[i].coverage, x, y, theta, objectives[i, 0], objectives[i, 1], law, world.ground,
-            fields[i], positions, i,
+            fields[i], positions, i, looks[i],
         )  # fmt: skip
         if safety.enabled:
             v, omega, flag_row[i] = filter_command(

@@ -74,15 +74,17 @@ def _engine_rate_once(agents: int, steps: int, scenario_path: Path, **overrides:
     flags = np.zeros((steps, agents), dtype=np.uint8)
     total = coverage_map.target_ticks * coverage_map.counted_cells
     safety, memory = safety_parameters(scenario), np.zeros((agents, MEMORY_SIZE), dtype=np.int64)
+    looks = np.full((agents, 2), np.nan)
 
     def advance(coverage: np.ndarray, at: np.ndarray, count: int) -> int:
         done, _, _ = advance_team(
-            coverage, at, objectives, law, world.ground, fields, safety, memory, count,
+            coverage, at, objectives, law, world.ground, fields, safety, memory, looks, count,
             coverage_map.uncovered_cells, coverage_map.deficit_ticks, total, trace, errors, flags,
         )  # fmt: skip
         return done
 
     advance(coverage_map.coverage.copy(), poses.copy(), 2)  # compile / load from cache
+    looks.fill(np.nan)  # the timed run starts as the warm-up did
     started = time.perf_counter()
     done = advance(coverage_map.coverage, poses, steps)
     return done * agents / (time.perf_counter() - started)

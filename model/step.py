@@ -65,6 +65,11 @@ def read_wedge(
     )
 
 
+def no_look() -> np.ndarray:
+    """A robot's ``look`` for :func:`decide_and_sense` before its first step: it has looked at nothing."""
+    return np.full(2, np.nan)
+
+
 @njit(cache=True)
 def decide_and_sense(
     coverage: np.ndarray,
@@ -78,12 +83,14 @@ def decide_and_sense(
     field: np.ndarray,
     positions: np.ndarray,
     me: int,
+    look: np.ndarray,
 ) -> tuple[float, float, float, int, int, np.ndarray]:
     """(v, ω, e_Ω) of one agent from its map and objective (eq. 6–16), and its delta window (eq. 3).
 
     On a terrain: ``field`` is the geodesic distance field of the objective (the global law follows the
     shortest free path when a wall hides it), ``positions`` (N, 2) every robot's position with this
-    one's at row ``me`` (teammates hide cells); in the open world neither is read."""
+    one's at row ``me`` (teammates hide cells), ``look`` (2,) the cell this robot looked at in the step before
+    (:func:`model.wall_law.cell_to_look_at`; NaN: none; the law writes it); in the open world none is read."""
     teammates = teammates_in_view(ground, positions, me, x, y, law.sensing_range)
     e_omega, w_left, w_right, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, teammates)
     if law.pursuit:
@@ -107,6 +114,7 @@ def decide_and_sense(
             ground,
             field,
             teammates,
+            look,
         )
     v, omega = combined_law(
         theta, e_omega, u_loc, theta_loc, u_glo, theta_glo, law.beta, law.k_v, law.k_omega, law.literal_omega
@@ -133,7 +141,7 @@ def load_kernels(coverage: np.ndarray, pose: tuple[float, float, float], law: La
     positions = np.array([[x, y]])
     field = np.zeros(ground.occupied.shape)
     v, omega, _, _, _, _ = decide_and_sense(
-        np.zeros_like(coverage), x, y, theta, x + 1.0, y, law, ground, field, positions, 0
+        np.zeros_like(coverage), x, y, theta, x + 1.0, y, law, ground, field, positions, 0, no_look()
     )
     move(x, y, theta, v, omega, law, ground)
 

@@ -11,7 +11,7 @@ from model.coverage_map import CoverageMap
 from model.ground import NO_FIELD, NO_POSITIONS, open_ground
 from model.parameters import initial_poses, law_parameters
 from model.scenario import Scenario
-from model.step import decide_and_sense, move
+from model.step import decide_and_sense, move, no_look
 from protocol.inbox import Membership, Received
 from protocol.messages import AgentState, AgentStep, MapDelta
 
@@ -35,7 +35,7 @@ def team_steps(scenario: Scenario, steps: int) -> list[list[AgentStep]]:
         of_step = []
         for agent, (x, y, theta) in enumerate(poses):
             v, omega, e_omega, row0, col0, ticks = decide_and_sense(
-                grid.coverage, x, y, theta, 15.0, 15.0, law, OPEN, NO_FIELD, NO_POSITIONS, 0
+                grid.coverage, x, y, theta, 15.0, 15.0, law, OPEN, NO_FIELD, NO_POSITIONS, 0, no_look()
             )
             next_pose = move(x, y, theta, v, omega, law, OPEN)
             delta = MapDelta(agent, step, row0, col0, ticks)

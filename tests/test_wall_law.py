@@ -10,8 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from model.ground import Ground
+from model.step import no_look
 from model.visibility import line_of_sight
-from model.wall_law import global_law_among_walls, uncovered_to_look_at
+from model.wall_law import cell_to_look_at, global_law_among_walls, uncovered_to_look_at
 
 TARGET = 100
 
@@ -49,14 +50,15 @@ def test_with_nothing_left_in_sight_the_robot_goes_nearer_instead_of_waiting():
     objective = (11.5, 12.5)  # within R/2, reachable straight: eq. 10 would back the robot away (u < 0)
     x, y = 9.5, 10.5
     u_glo, theta = global_law_among_walls(
-        coverage, TARGET, x, y, *objective, -0.3, 0.0, 20.0, 1.0, False, ground, np.zeros((20, 20)), np.zeros((0, 2))
-    )
+        coverage, TARGET, x, y, *objective, -0.3, 0.0, 20.0, 1.0, False, ground, np.zeros((20, 20)), np.zeros((0, 2)),
+        no_look(),
+    )  # fmt: skip
     assert u_glo == 0.3  # nearer, at eq. 10's speed for this distance
     assert math.isclose(theta, math.atan2(objective[1] - y, objective[0] - x))
     coverage_in_sight = one_uncovered_cell(12, 10)
     u_glo, theta = global_law_among_walls(
         coverage_in_sight, TARGET, x, y, *objective, -0.3, 0.0, 20.0, 1.0, False, ground, np.zeros((20, 20)),
-        np.zeros((0, 2)),
+        np.zeros((0, 2)), no_look(),
     )  # fmt: skip
     assert u_glo == 0.0 and math.isclose(theta, math.atan2(12.5 - y, 10.5 - x))  # stops and looks
 
@@ -118,3 +120,50 @@ def test_a_robot_on_the_centre_of_the_last_uncovered_cell_looks_at_it():
         10.5,
         10.5,
     )
+
+
+def test_a_robot_keeps_looking_at_its_cell_until_it_is_covered_then_looks_at_the_nearest():
+    ground, none = ground_of(np.zeros((20, 20), dtype=bool)), np.zeros((0, 2))
+    coverage = np.full((20, 20), TARGET, dtype=np.int64)
+    coverage[10, 14] = coverage[10, 16] = 0  # two uncovered cells east of the robot, 4 and 6 away
+    x, y, objective = 10.5, 10.5, (10.5, 10.5)  # the objective's cell is covered
+
+    def looked_at(look, coverage=coverage, ground=ground, teammates=none, reach=20.0):
+        return cell_to_look_at(coverage, TARGET, ground, teammates, x, y, *objective, reach, 1.0, look)
+
+    nearest, farther = (14.5, 10.5), (16.5, 10.5)
+    assert looked_at(no_look()) == nearest
+    kept = np.array(farther)  # looked at the farther one in the step before: kept while uncovered and in sight
+    assert looked_at(kept) == farther
+    assert looked_at(kept, reach=5.5) == nearest  # out of R now
+    walled = np.zeros((20, 20), dtype=bool)
+    walled[10, 15] = True  # a wall between: hidden
+    assert looked_at(kept, ground=ground_of(walled)) == nearest
+    teammate = np.array([[15.5, 10.5]])  # a teammate's disk between: hidden with occlusion, not without
+    assert looked_at(kept, teammates=teammate) == nearest
+    assert (
+        looked_at(kept, ground=ground_of(np.zeros((20, 20), dtype=bool), occlusion=False), teammates=teammate)
+        == farther
+    )
+    covered = coverage.copy()
+    covered[10, 16] = TARGET
+    assert looked_at(kept, coverage=covered) == nearest
+    objective_uncovered = coverage.copy()
+    objective_uncovered[10, 10] = 0  # the objective's cell, uncovered and in sight, comes first
+    assert looked_at(kept, coverage=objective_uncovered) == (10.5, 10.5)
+
+
+def test_the_law_remembers_what_it_looked_at_and_forgets_it_once_it_drives():
+    ground = ground_of(np.zeros((20, 20), dtype=bool))
+    coverage = one_uncovered_cell(10, 14)
+    x, y, objective, look = 10.5, 10.5, (11.5, 10.5), no_look()
+    u_glo, _ = global_law_among_walls(
+        coverage, TARGET, x, y, *objective, -0.3, 0.0, 20.0, 1.0, False, ground, np.zeros((20, 20)), np.zeros((0, 2)),
+        look,
+    )  # fmt: skip
+    assert u_glo == 0.0 and tuple(look) == (14.5, 10.5)  # within R/2: stops and looks, and remembers
+    u_glo, _ = global_law_among_walls(
+        coverage, TARGET, x, y, *objective, 0.3, 0.0, 20.0, 1.0, False, ground, np.zeros((20, 20)), np.zeros((0, 2)),
+        look,
+    )  # fmt: skip
+    assert u_glo == 0.3 and np.isnan(look).all()  # drives: forgets
