@@ -42,7 +42,7 @@ speed moves a single timing by up to 10 %, and the fastest is the one least dist
 def engine_rate(agents: int, steps: int, scenario_path: Path = PAPER_SCENARIO, **overrides: object) -> float:
     """Agent-steps/s of the engine's kernel on a scenario (a map: walls, bodies and occlusion included), the
     best of REPEATS timings."""
-    return max(_engine_rate_once(agents, steps, scenario_path, **overrides) for _ in range(REPEATS))
+    return engine_rates_in_turn(agents, steps, (scenario_path, overrides), repeats=REPEATS)[0]
 
 
 COMPARED_REPEATS = 10
@@ -52,10 +52,12 @@ ratio of rates timed one after the other took that drift in (the empty domain's 
 227,000 between runs, which was most of the fixed-point ratio's spread)."""
 
 
-def engine_rates_in_turn(agents: int, steps: int, *configurations: tuple[Path, dict[str, object]]) -> list[float]:
-    """:func:`engine_rate` of each (scenario path, overrides), timed in turn (:data:`COMPARED_REPEATS`)."""
+def engine_rates_in_turn(
+    agents: int, steps: int, *configurations: tuple[Path, dict[str, object]], repeats: int = COMPARED_REPEATS
+) -> list[float]:
+    """:func:`engine_rate` of each (scenario path, overrides), timed in turn, best of ``repeats`` rounds."""
     best = [0.0] * len(configurations)
-    for _ in range(COMPARED_REPEATS):
+    for _ in range(repeats):
         for k, (path, overrides) in enumerate(configurations):
             best[k] = max(best[k], _engine_rate_once(agents, steps, path, **overrides))
     return best

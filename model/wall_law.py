@@ -100,7 +100,8 @@ def cell_to_look_at(
 ) -> tuple[float, float]:
     """What a robot standing at (x, y) looks at: the objective's cell if it is uncovered and in clear sight;
     else the cell it looked at in the step before (``look``) while that one is still uncovered, within R and
-    in clear sight; else the nearest such cell (:func:`uncovered_to_look_at`). A cell is so kept until it is
+    in clear sight; else the nearest such cell (:func:`_nearest_uncovered_in_sight`; NaN if none: with ``look``
+    NaN, this is the objective's cell or the nearest, the rule before a cell was kept). A cell is so kept until it is
     covered, leaves R or clear sight, or the objective's cell comes first, or the robot drives again (the law
     then forgets it): a search of R every step found the same cell nearly always (99 % of a standing robot's
     steps on the warehouse map) and could turn the robot between two cells as it crept."""
@@ -149,33 +150,6 @@ def _objective_cell_in_sight(
 
 
 @njit(cache=True)
-def uncovered_to_look_at(
-    coverage: np.ndarray,
-    target_ticks: int,
-    ground: Ground,
-    teammates: np.ndarray,
-    x: float,
-    y: float,
-    objective_x: float,
-    objective_y: float,
-    sensing_range: float,
-    cell: float,
-) -> tuple[float, float]:
-    """The centre of the objective's cell if it is uncovered and in clear sight, else of the nearest
-    uncovered cell within R of (x, y) in clear sight (no wall and, with occlusion, no teammate's disk
-    across: the camera's own rule); (NaN, NaN) if there is none."""
-    centre_x, centre_y = _objective_cell_in_sight(
-        coverage, target_ticks, ground, teammates, x, y, objective_x, objective_y, cell
-    )
-    if centre_x == centre_x:
-        return centre_x, centre_y
-    hiding = teammates if ground.occlusion else teammates[:0]
-    return _nearest_uncovered_in_sight(
-        coverage, target_ticks, ground.occupied, hiding, ground.radius, x, y, sensing_range, cell
-    )
-
-
-@njit(cache=True)
 def _nearest_uncovered_in_sight(
     coverage: np.ndarray,
     target_ticks: int,
@@ -187,7 +161,7 @@ def _nearest_uncovered_in_sight(
     sensing_range: float,
     cell: float,
 ) -> tuple[float, float]:
-    """:func:`uncovered_to_look_at`'s search beyond the objective's cell: the centre of the nearest uncovered
+    """:func:`cell_to_look_at`'s search beyond the objective's cell: the centre of the nearest uncovered
     free cell within R of (x, y) that no wall and no disk of ``hiding`` hides; (NaN, NaN) if none."""
     rows, cols = coverage.shape
     centre_row, centre_col = math.floor(y / cell), math.floor(x / cell)

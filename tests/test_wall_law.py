@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from model.ground import Ground
 from model.step import no_look
 from model.visibility import line_of_sight
-from model.wall_law import cell_to_look_at, global_law_among_walls, uncovered_to_look_at
+from model.wall_law import cell_to_look_at, global_law_among_walls
 
 TARGET = 100
 
@@ -32,13 +32,15 @@ def test_a_cell_a_teammate_hides_is_not_looked_at():
     occupied[0, 0] = True  # a terrain, so the law among walls applies
     coverage = one_uncovered_cell(10, 15)
     ground = ground_of(occupied)
-    alone = uncovered_to_look_at(coverage, TARGET, ground, np.zeros((0, 2)), 5.5, 10.5, 15.5, 10.5, 20.0, 1.0)
+    alone = cell_to_look_at(coverage, TARGET, ground, np.zeros((0, 2)), 5.5, 10.5, 15.5, 10.5, 20.0, 1.0, no_look())
     assert alone == (15.5, 10.5)
     teammate_between = np.array([[10.5, 10.5]])
-    hidden = uncovered_to_look_at(coverage, TARGET, ground, teammate_between, 5.5, 10.5, 15.5, 10.5, 20.0, 1.0)
+    hidden = cell_to_look_at(coverage, TARGET, ground, teammate_between, 5.5, 10.5, 15.5, 10.5, 20.0, 1.0, no_look())
     assert all(math.isnan(value) for value in hidden)
     without_occlusion = ground_of(occupied, occlusion=False)
-    seen = uncovered_to_look_at(coverage, TARGET, without_occlusion, teammate_between, 5.5, 10.5, 15.5, 10.5, 20.0, 1.0)
+    seen = cell_to_look_at(
+        coverage, TARGET, without_occlusion, teammate_between, 5.5, 10.5, 15.5, 10.5, 20.0, 1.0, no_look()
+    )
     assert seen == (15.5, 10.5)  # the camera's own rule: no occlusion, nothing hides it
 
 
@@ -64,7 +66,7 @@ def test_with_nothing_left_in_sight_the_robot_goes_nearer_instead_of_waiting():
 
 
 def nearest_in_sight_by_scan(coverage, ground, teammates, x, y, objective_x, objective_y, reach, cell):
-    """The rule of uncovered_to_look_at, cell by cell with the exact test and nothing pruned."""
+    """The rule of cell_to_look_at with nothing looked at before, cell by cell with the exact test and nothing pruned."""
     hiding = teammates if ground.occlusion else teammates[:0]
     rows, cols = coverage.shape
     row = min(max(math.floor(objective_y / cell), 0), rows - 1)
@@ -106,7 +108,7 @@ def test_the_look_at_search_finds_what_a_scan_of_every_cell_finds(seed, uncovere
     teammates = np.array([x, y]) + rng.uniform(1.1, 5.0, 3)[:, None] * np.stack([np.cos(angles), np.sin(angles)], 1)
     ground = ground_of(occupied, 0.5, occlusion)
     objective = rng.uniform(0.0, 40.0, 2)
-    found = uncovered_to_look_at(coverage, TARGET, ground, teammates, x, y, *objective, 20.0, 1.0)
+    found = cell_to_look_at(coverage, TARGET, ground, teammates, x, y, *objective, 20.0, 1.0, no_look())
     expected = nearest_in_sight_by_scan(coverage, ground, teammates, x, y, *objective, 20.0, 1.0)
     assert np.array_equal(found, expected, equal_nan=True)
 
@@ -116,7 +118,7 @@ def test_a_robot_on_the_centre_of_the_last_uncovered_cell_looks_at_it():
     occupied[0, 0] = True
     coverage = one_uncovered_cell(10, 10)
     ground = ground_of(occupied)
-    assert uncovered_to_look_at(coverage, TARGET, ground, np.zeros((0, 2)), 10.5, 10.5, 3.5, 3.5, 20.0, 1.0) == (
+    assert cell_to_look_at(coverage, TARGET, ground, np.zeros((0, 2)), 10.5, 10.5, 3.5, 3.5, 20.0, 1.0, no_look()) == (
         10.5,
         10.5,
     )
