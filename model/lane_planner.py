@@ -1,4 +1,5 @@
-"""The ``anicov`` controller's planner: a spiral at the sensor's best spacing, then passes over what is left.
+"""The ``anicov`` controller's planner: a spiral at the sensor's best spacing, orbits over what it will leave,
+then passes over what is left.
 
 Beyond the paper (docs/controller.md has the measurements and the reasons). What the runs of the
 paper's law show: a robot stands R/2 from a blob's centroid and stares at it (eq. 10), and a camera
@@ -21,7 +22,12 @@ straight pass at full speed wastes least. So:
    piece ends at the centre gets less spiral, to take the passes the small innermost ring leaves there;
    and of the spiral's 8 symmetries (which corner it starts from, which way it turns) the one that
    finishes soonest is flown.
-3. **Passes.** A robot done with its piece takes the uncovered blobs in turns (cells with Υ > 0 within
+3. **Touch-ups.** The routes are flown once here, as the engine will fly them
+   (:func:`model.touch_ups.simulate_routes`), and every group of cells they will leave short gets an
+   orbit, a small circle whose forward camera sweeps all around it, appended to the route of the robot
+   that will finish it soonest (:func:`model.touch_ups.with_touch_ups`; a team of one leaves its route
+   for it and comes back). An orbit whose cells are covered by the time its robot gets there is skipped.
+4. **Passes.** A robot done with its piece takes the uncovered blobs in turns (cells with Υ > 0 within
    a lane spacing of each other, leaving out the strips robots still on their piece will sweep): the
    assignment of free robots to blobs minimises their total distance, and a pass runs along the blob's
    major axis through its centroid, from its nearer end (or from before it, to make the pass at least
@@ -37,13 +43,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from model.objectives import BlobObjectives
 from model.routes import Route, balanced_routes, best_lane_spacing, lead_in
 from model.scenario import Scenario
+from model.touch_ups import TouchUp, blob_labels, with_touch_ups
 
 Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
 
@@ -60,11 +66,7 @@ def blob_passes(
     centroids; the blob labels of the grid. A blob: the cells with Υ > 0 that lie closer than a lane spacing to
     each other (8-connected once grown by half a spacing), so that the scraps a row of lanes leaves
     along an edge make one pass along it, not one each."""
-    uncovered = (lack > 0.0).astype(np.uint8)
-    reach = max(1, round(spacing / 2.0 / cell))
-    grown = cv2.dilate(uncovered, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1, 2 * reach + 1)))
-    count, labels = cv2.connectedComponents(grown, connectivity=8)
-    labels = labels * uncovered
+    count, labels = blob_labels(lack > 0.0, cell, spacing)
     ways, centres = [], []
     for k in range(1, count):
         rows, cols = np.nonzero(labels == k)
@@ -89,6 +91,7 @@ class LanePlanner:
     scenario: Scenario
     blobs: BlobObjectives = field(default_factory=BlobObjectives)
     routes: dict[int, Route] = field(default_factory=dict)
+    touch_ups: dict[int, list[TouchUp]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.spacing = best_lane_spacing(self.scenario)
@@ -99,13 +102,17 @@ class LanePlanner:
         ids = list(range(len(positions))) if members is None else list(members)
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
         if not self.routes:
-            routes = balanced_routes(self.scenario, self.spacing, self._all(ids, positions), self.lead)
+            start = self._all(ids, positions)
+            routes = balanced_routes(self.scenario, self.spacing, start, self.lead)
+            routes, touch_ups = with_touch_ups(self.scenario, routes, start, LOOKAHEAD, self.spacing)
             for agent, route in zip(range(self.scenario.agents), routes, strict=True):
                 self.routes[agent] = Route.of(route)
+                self.touch_ups[agent] = touch_ups[agent]
         window = LOOKAHEAD  # no robot is past the carrot it was given (it slows to stop on it)
         free = []
         for index, agent in enumerate(ids):
             route = self.routes[agent]
+            self._skip_done_touch_ups(agent, lack)
             route.advance(positions[index], window)
             if route.done():
                 free.append(index)
@@ -115,6 +122,17 @@ class LanePlanner:
             [self.routes[agent].point_at(self.routes[agent].progress + LOOKAHEAD) for agent in ids], dtype=np.float64
         )
         return targets.reshape(-1, 2)
+
+    def _skip_done_touch_ups(self, agent: int, lack: np.ndarray) -> None:
+        """A touch-up (:mod:`model.touch_ups`) whose cells are all covered by the time its robot's carrot
+        reaches it is skipped: foretold from the planned routes alone, a spot may be covered by then (by a
+        pass, or by a robot whose start heading was not the one foretold). One flown already is forgotten."""
+        route, waiting = self.routes[agent], self.touch_ups.get(agent, [])
+        while waiting and (
+            waiting[0].end <= route.progress
+            or (waiting[0].start <= route.progress + LOOKAHEAD and not (lack[waiting[0].spot] > 0.0).any())
+        ):
+            route.progress = max(route.progress, waiting.pop(0).end)
 
     def resume(self, lack: np.ndarray, positions: np.ndarray, members: list[int]) -> None:
         """A planner rebuilt after its coordinator was lost in realtime, its routes cut again at a first
