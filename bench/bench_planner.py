@@ -1,0 +1,58 @@
+"""How long the anicov controller's first plan takes: the spiral's 8 symmetries balanced, then the routes
+flown once to foresee what they leave short and the orbits over it (model.touch_ups). In realtime the
+team waits this long for its first carrots; in lockstep and in the engine it is paid once per run.
+
+    .venv/bin/python bench/bench_planner.py
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from bench.machine import describe_machine
+from model.lane_planner import LanePlanner
+from model.parameters import starting_poses
+from model.scenario import load_scenario
+
+SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+CASES = [
+    ("paper.toml", 1),
+    ("paper.toml", 4),
+    ("paper.toml", 10),
+    ("paper.toml", 30),
+    ("wide.toml", 1),
+    ("wide.toml", 30),
+]
+SEEDS = (0, 1, 2)
+
+
+def first_plan_seconds(config: str, agents: int, seed: int) -> tuple[float, int]:
+    """(seconds of the first plan, orbits planned) for one team's random start."""
+    scenario = load_scenario(SCENARIOS / config).with_overrides(controller="anicov", agents=agents, seed=seed)
+    planner = LanePlanner(scenario)
+    positions = starting_poses(scenario)[:, :2]
+    started = time.perf_counter()
+    planner.plan(np.ones(scenario.grid_shape), positions)
+    return time.perf_counter() - started, sum(len(touch_ups) for touch_ups in planner.touch_ups.values())
+
+
+def main() -> None:
+    print(f"machine: {describe_machine()}")
+    first_plan_seconds("paper.toml", 1, 0)  # numba's kernels loaded before timing
+    print("| scenario | N | first plan, s (seeds 0-2) | orbits |")
+    print("|---|---|---|---|")
+    for config, agents in CASES:
+        timed = [first_plan_seconds(config, agents, seed) for seed in SEEDS]
+        seconds = ", ".join(f"{s:.2f}" for s, _ in timed)
+        orbits = ", ".join(str(n) for _, n in timed)
+        print(f"| {config} | {agents} | {seconds} | {orbits} |")
+
+
+if __name__ == "__main__":
+    main()
