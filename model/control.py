@@ -84,7 +84,10 @@ def pursuit_law(
     dy = objective_y - y
     e_theta = wrap_angle(math.atan2(dy, dx) - theta)
     arrive = min(1.0, math.sqrt(dx * dx + dy * dy) / (k_v * dt))
-    return k_v * arrive * (1.0 - (2.0 / math.pi) * abs(e_theta)), k_omega * e_theta
+    # Held at -1: at |e_θ| one ulp from π the product (2/π)|e_θ| rounds past 2 (hypothesis found
+    # v = -1.0000000000000004 at θ = 3.1415926535897927 with the carrot straight behind).
+    heading = max(-1.0, 1.0 - (2.0 / math.pi) * abs(e_theta))
+    return k_v * arrive * heading, k_omega * e_theta
 
 
 @njit(cache=True)

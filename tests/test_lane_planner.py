@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from anicov.engine import run_scenario
@@ -63,6 +63,7 @@ def test_carrots_lead_each_robot_along_its_route_and_a_robot_with_nothing_left_s
 
 @settings(max_examples=300)
 @given(st.floats(-50, 50), st.floats(-50, 50), st.floats(-math.pi, math.pi), st.floats(-50, 50), st.floats(-50, 50))
+@example(0.0, 1.0, 3.1415926535897927, 1.0, 1.0)  # the carrot straight behind: (2/π)|e_θ| rounded past 2
 def test_the_pursuit_law_keeps_the_papers_velocity_bounds(x, y, theta, goal_x, goal_y):
     v, omega = pursuit_law(x, y, theta, goal_x, goal_y, 1.0, 1.0, 0.1)
     assert abs(v) <= 1.0 and abs(omega) <= math.pi + 1e-12  # eq. 15-16: |v| ≤ k_v, |ω| ≤ π k_ω
