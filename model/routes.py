@@ -10,7 +10,8 @@ the planner that gives the carrots along these routes):
   the outer ring d100 inside the edges; :func:`spiral_variants`: the same in the domain's 8 symmetries.
 - :func:`balanced_routes`: the spiral cut into N pieces flown inward, robots assigned to pieces by the
   least longest transit (:func:`bottleneck_assignment` on scipy's ``linear_sum_assignment``), the pieces
-  resized until every robot finishes together, on the symmetry that finishes first.
+  resized until every robot finishes together, on the symmetry that finishes first; then the order in
+  which robots take pieces improved and the pieces cut again for it (:mod:`model.piece_order`).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment, minimize_scalar
 
 from model.metrics import pass_reach, straight_pass_coverage
+from model.piece_order import Spiral, cuts_for, improved_order, start_run_ups
 from model.scenario import Scenario
 from model.zigzag import path_between, point_along
 
@@ -36,6 +38,16 @@ CENTRE_ALLOWANCE_LEADS = 8.0
 """Run-ups of extra work counted for the robot whose piece ends at the spiral's centre (balanced_routes)."""
 TIE = 1e-9
 """Estimated finishes (units) closer than this are a tie: the first candidate stays."""
+SEAM_OVERLAP = 2.0
+"""How far back along the spiral from its cut a piece after the first is entered (units): the carrot's
+distance (:data:`model.lane_planner.LOOKAHEAD`), in which a robot arriving at an angle turns onto the
+spiral. Entered at the cut itself, a seam left a few cells a few per cent short, and at N = 30 on the
+200 x 50 strip (8 seeds) their orbits cost the team more than the overlap: 18.6 groups of such cells
+against 2.8, 2.02 t* against 1.95."""
+ORDERED_VARIANTS = 2
+"""Of the spiral's 8 symmetries, how many (the soonest after resizing) have their order improved
+(:mod:`model.piece_order`): all 8 were within 0.01 t* of the best 2 at N = 4 - 30 (8 seeds), at four
+times the planning time."""
 
 
 def best_lane_spacing(scenario: Scenario) -> float:
@@ -198,24 +210,52 @@ def spiral_variants(scenario: Scenario, spacing: float) -> list[np.ndarray]:
 
 
 def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, lead: float) -> list[np.ndarray]:
-    """Each robot's route, its piece sized so that the team finishes together, on whichever of the
-    spiral's 8 symmetries (:func:`spiral_variants`) gives the earliest estimated finish (the first on a
-    tie, near-ties of rounding included: on a square, symmetric variants differ only in the last bits):
-    at random starts, the bottleneck transit depends on where the spiral starts and which way it turns
-    (measured, 4 seeds: N = 4 2.76 -> 2.67 t*, N = 30 3.78 -> 3.58)."""
-    best, best_finish = None, math.inf
+    """Each robot's route, its piece sized so that the team finishes together. Every one of the spiral's 8
+    symmetries (:func:`spiral_variants`) has its pieces resized (:func:`balanced_routes_on`): at random
+    starts, the bottleneck transit depends on where the spiral starts and which way it turns (measured, 4
+    seeds: N = 4 2.76 -> 2.67 t*, N = 30 3.78 -> 3.58). On the :data:`ORDERED_VARIANTS` that finish
+    soonest so (the first on a tie), the order in which robots take pieces is improved and the pieces cut
+    again for it (:func:`ordered_routes`), and the sooner is flown. A robot alone flies the soonest."""
+    tried = []
     for path in spiral_variants(scenario, spacing):
-        routes, finish = balanced_routes_on(scenario, path, positions, lead)
+        routes, finish, owners = balanced_routes_on(scenario, path, positions, lead)
+        tried.append((finish, path, routes, owners))
+    soonest = sorted(range(len(tried)), key=lambda k: tried[k][0])  # stable: the first on a tie
+    if scenario.agents == 1:
+        return tried[soonest[0]][2]
+    best, best_finish = None, math.inf
+    for k in soonest[:ORDERED_VARIANTS]:
+        _, path, _, owners = tried[k]
+        routes, finish = ordered_routes(scenario, path, positions, lead, np.array(owners))
         if finish < best_finish - TIE:
             best, best_finish = routes, finish
     assert best is not None
     return best
 
 
+def ordered_routes(
+    scenario: Scenario, spiral: np.ndarray, positions: np.ndarray, lead: float, order: np.ndarray
+) -> tuple[list[np.ndarray], float]:
+    """Routes on ``spiral`` for the best order near ``order`` (:func:`model.piece_order.improved_order`)
+    and its finish: the pieces cut so that each takes its robot the same time; a robot left without a
+    piece (its transit alone too long) has a route of its own position, and takes passes from the start."""
+    whole = Route.of(spiral)
+    allowance = CENTRE_ALLOWANCE_LEADS * lead if scenario.agents > 1 else 0.0
+    cut_on = Spiral(whole.points, whole.along, lead, allowance, SEAM_OVERLAP)
+    order, finish = improved_order(order, positions, cut_on)
+    routes = [positions[robot][None, :].copy() for robot in range(len(positions))]
+    for robot, start, end in cuts_for(order, finish, positions, cut_on):
+        piece = path_between(whole.points, cut_on.entered(start) if start > 0.0 else 0.0, end)
+        if start == 0.0:
+            piece = with_run_up(piece, float(start_run_ups(positions[robot], whole.points[0], lead)))
+        routes[robot] = np.vstack([positions[robot][None, :], piece])
+    return routes, finish
+
+
 def balanced_routes_on(
     scenario: Scenario, spiral: np.ndarray, positions: np.ndarray, lead: float
-) -> tuple[list[np.ndarray], float]:
-    """Routes on ``spiral`` and their estimated finish. From equal pieces, each round assigns robots to
+) -> tuple[list[np.ndarray], float, list[int]]:
+    """Routes on ``spiral``, their estimated finish and each piece's robot, in the spiral's order. From equal pieces, each round assigns robots to
     pieces (:func:`assign_pieces`), then moves every piece's length halfway to the one that makes
     transit, run-up and flight the same for all; the routes with the earliest estimated finish (longest
     transit + run-up + piece) are kept (the first on a near-tie). The last piece, which ends on the
@@ -228,17 +268,18 @@ def balanced_routes_on(
     whole = Route.of(spiral)
     total = whole.length
     if total <= 0.0:  # a domain within 2·d100 on both sides: one point, every robot goes there
-        return [np.vstack([position, whole.points[:1]]) for position in positions], 0.0
+        return [np.vstack([position, whole.points[:1]]) for position in positions], 0.0, list(range(len(positions)))
     lengths = np.full(scenario.agents, total / scenario.agents)
     allowance = np.zeros(scenario.agents)
     allowance[-1] = CENTRE_ALLOWANCE_LEADS * lead if scenario.agents > 1 else 0.0
-    best, best_finish = None, math.inf
+    best, best_finish, best_owners = None, math.inf, []
     for _ in range(BALANCING_ROUNDS + 1):
         cuts = np.concatenate([[0.0], np.cumsum(lengths)])
         cuts[-1] = total
         pieces = cut(whole, cuts)
         routes, owners = assign_pieces(pieces, positions, lead, with_owners=True)
-        run_ups = np.where(np.arange(len(pieces)) == 0, lead, 0.0)  # the spiral's start only (assign_pieces)
+        run_ups = np.zeros(len(pieces))  # the spiral's start only (assign_pieces)
+        run_ups[0] = start_run_ups(positions[owners[0]], whole.points[0], lead)
         transit = (
             allowance
             + run_ups
@@ -246,11 +287,11 @@ def balanced_routes_on(
         )
         finish = float(np.max(transit + lengths))
         if finish < best_finish - TIE:
-            best, best_finish = routes, finish
+            best, best_finish, best_owners = routes, finish, owners
         target = np.maximum((total + transit.sum()) / scenario.agents - transit, MIN_PIECE * total / scenario.agents)
         lengths = 0.5 * lengths + 0.5 * target / target.sum() * total
     assert best is not None
-    return best, best_finish
+    return best, best_finish, best_owners
 
 
 def with_run_up(piece: np.ndarray, lead: float) -> np.ndarray:
@@ -280,18 +321,22 @@ def bottleneck_assignment(cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def assign_pieces(pieces: list[np.ndarray], positions: np.ndarray, lead: float, with_owners: bool = False) -> Any:
     """Each robot's route: its start, then its piece. The first piece (the spiral's start) is entered
-    ``lead`` before its first point; the others start where the piece before them ends: a point beside
+    ``lead`` before its first point (twice that for a robot starting near it: :func:`start_run_ups`); the others start where the piece before them ends: a point beside
     the spiral just past a seam is seen by the camera of the robot ending there from behind, as a run-up
     would (measured, 8 seeds, without a run-up at the seams: N = 4 2.65 -> 2.61 t*, N = 10 2.98 -> 2.88,
     N = 30 3.59 -> 3.41). Pieces are flown the way the spiral goes (inward: flown outward, a ring's
     corners leave gaps the next ring does not close); the assignment minimises the longest transit,
     then the total. ``with_owners``: also each piece's robot."""
-    entries = [with_run_up(piece, lead) if k == 0 else piece for k, piece in enumerate(pieces)]
-    transit = np.array([[np.linalg.norm(route[0] - p) for route in entries] for p in positions])
+    run_ups = start_run_ups(positions, pieces[0][0], lead)  # the first piece's, each robot's own
+    transit = np.array([[np.linalg.norm(piece[0] - p) for piece in pieces] for p in positions])
+    transit[:, 0] = [
+        np.linalg.norm(with_run_up(pieces[0], run_up)[0] - p) for run_up, p in zip(run_ups, positions, strict=True)
+    ]
     robots, chosen = bottleneck_assignment(transit)
     routes: list[np.ndarray] = [np.zeros((0, 2))] * len(positions)
     owners = [0] * len(pieces)
     for robot, piece in zip(robots, chosen, strict=True):
-        routes[robot] = np.vstack([positions[robot][None, :], entries[piece]])
+        entry = with_run_up(pieces[0], float(run_ups[robot])) if piece == 0 else pieces[piece]
+        routes[robot] = np.vstack([positions[robot][None, :], entry])
         owners[piece] = int(robot)
     return (routes, owners) if with_owners else routes

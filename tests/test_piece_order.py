@@ -1,0 +1,128 @@
+"""model.piece_order: pieces cut for an order of robots, the order's finish, its local search, and the run-up
+before the spiral's first point."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from model.lane_planner import LOOKAHEAD
+from model.piece_order import Spiral, cuts_for, improved_order, neighbours, order_finishes, start_run_ups
+from model.routes import (
+    CENTRE_ALLOWANCE_LEADS,
+    SEAM_OVERLAP,
+    Route,
+    balanced_routes_on,
+    best_lane_spacing,
+    lead_in,
+    ordered_routes,
+    spiral_path,
+    with_run_up,
+)
+from model.scenario import Scenario
+from model.touch_ups import simulate_routes
+from model.zigzag import path_between
+
+PAPER = Scenario().with_overrides(controller="anicov")
+SPACING = best_lane_spacing(PAPER)
+LEAD = lead_in(PAPER, SPACING)
+
+
+def _spiral(scenario: Scenario = PAPER) -> tuple[Route, Spiral]:
+    whole = Route.of(spiral_path(scenario, SPACING))
+    return whole, Spiral(whole.points, whole.along, LEAD, CENTRE_ALLOWANCE_LEADS * LEAD)
+
+
+def _times(pieces: list[tuple[int, float, float]], positions: np.ndarray, cut_on: Spiral) -> list[float]:
+    """Each piece's robot's time at k_v = 1, from the pieces themselves: transit to where the piece begins
+    (the first: to its run-up, and the run-up), the piece, and the allowance for the one ending at the end."""
+    times = []
+    for robot, start, end in pieces:
+        if start == 0.0:
+            transit = float(cut_on.first_transits(positions[robot]))
+        else:  # entered the overlap before its cut
+            entered = Route.of(cut_on.points).point_at(start - cut_on.overlap)
+            transit = float(np.linalg.norm(positions[robot] - entered)) + cut_on.overlap
+        times.append(transit + end - start + (cut_on.allowance if end >= cut_on.length - 1e-9 else 0.0))
+    return times
+
+
+@pytest.mark.parametrize("overlap", [0.0, SEAM_OVERLAP])
+def test_an_orders_finish_is_the_least_at_which_its_pieces_reach_the_spirals_end(overlap):
+    whole, cut_on = _spiral()
+    cut_on = Spiral(cut_on.points, cut_on.along, cut_on.lead, cut_on.allowance, overlap)
+    positions = np.random.default_rng(3).uniform(0.0, 100.0, (6, 2))
+    order = np.array([4, 0, 5, 2, 1, 3])
+    finish = float(order_finishes(order[None, :], positions, cut_on)[0])
+    pieces = cuts_for(order, finish, positions, cut_on)
+    # Consecutive from the spiral's start to its end, every robot done within the finish, all at it.
+    assert pieces[0][1] == 0.0 and pieces[-1][2] == pytest.approx(whole.length)
+    assert all(a[2] == pytest.approx(b[1]) for a, b in itertools.pairwise(pieces))
+    assert _times(pieces, positions, cut_on) == pytest.approx([finish] * len(pieces), abs=1e-6)
+    # A little sooner, the same order's pieces fall short of the end, or the last robot's allowance does.
+    sooner = cuts_for(order, finish - 0.01, positions, cut_on)
+    assert sooner[-1][2] < whole.length - 1e-3 or max(_times(sooner, positions, cut_on)) > finish - 0.01 + 1e-6
+    # Many orders at once give what each gives alone.
+    orders = np.array([order, order[::-1], np.roll(order, 2)])
+    each = [order_finishes(o[None, :], positions, cut_on)[0] for o in orders]
+    assert order_finishes(orders, positions, cut_on) == pytest.approx(each)
+
+
+def test_a_robot_whose_transit_alone_is_too_long_flies_nothing_and_the_next_starts_the_spiral_with_a_run_up():
+    whole, cut_on = _spiral(PAPER.with_overrides(agents=2))
+    near_start = whole.points[0] + np.array([20.0, 20.0])
+    far_off = np.array([5000.0, 5000.0])  # farther than the whole spiral takes one robot
+    positions = np.array([far_off, near_start])
+    order = np.array([0, 1])
+    finish = float(order_finishes(order[None, :], positions, cut_on)[0])
+    assert finish == pytest.approx(whole.length + cut_on.allowance + cut_on.first_transits(near_start), abs=1e-6)
+    assert cuts_for(order, finish, positions, cut_on) == [(1, 0.0, pytest.approx(whole.length))]
+    routes, routes_finish = ordered_routes(PAPER.with_overrides(agents=2), whole.points, positions, LEAD, order)
+    assert routes_finish == pytest.approx(finish)
+    assert np.array_equal(routes[0], far_off[None, :])  # no route: it takes passes from the start
+    assert np.allclose(routes[1][2], whole.points[0]) and np.linalg.norm(routes[1][2] - routes[1][1]) == pytest.approx(
+        LEAD
+    )
+
+
+def test_the_neighbours_are_every_swap_and_every_move_once():
+    order = np.arange(6)
+    around = neighbours(order)
+    assert all(sorted(o) == list(range(6)) for o in around)
+    assert len({tuple(o) for o in around}) == len(around) == 15 + 6 * 6 - 6 - 2 * 5  # swaps, then moves by 2+
+    assert [1, 0, 2, 3, 4, 5] in around.tolist() and [1, 2, 3, 0, 4, 5] in around.tolist()
+
+
+def test_the_improved_order_finds_the_best_of_all_orders_of_five_and_is_never_later_than_where_it_began():
+    _, cut_on = _spiral()
+    positions = np.random.default_rng(2).uniform(0.0, 100.0, (5, 2))
+    every = np.array(list(itertools.permutations(range(5))))
+    finishes = order_finishes(every, positions, cut_on)
+    worst = every[int(np.argmax(finishes))]
+    order, finish = improved_order(worst, positions, cut_on)
+    assert finish == pytest.approx(finishes.min(), abs=1e-6) and finishes.min() < finishes.max() - 40.0
+    assert finish == pytest.approx(float(order_finishes(order[None, :], positions, cut_on)[0]))
+    # From the resized pieces' own order (model.routes), never later than they were estimated.
+    scenario = PAPER.with_overrides(agents=8, seed=5)
+    positions = np.random.default_rng(5).uniform(0.0, 100.0, (8, 2))
+    _, resized, owners = balanced_routes_on(scenario, cut_on.points, positions, LEAD)
+    assert improved_order(np.array(owners), positions, cut_on)[1] <= resized + 1e-6
+
+
+def test_a_robot_starting_near_the_spirals_first_point_gets_twice_the_run_up_and_leaves_its_corner_covered():
+    whole, _ = _spiral()
+    start = whole.points[0]
+    assert start_run_ups(np.array([start + 1.0, start + 20.0]), start, LEAD) == pytest.approx([2 * LEAD, LEAD])
+    # At (1, 1), inside the corner, the single run-up left cells of the corner short; the double one
+    # none (the first 50 units flown by this robot, the rest of the spiral by another).
+    robot = np.array([1.0, 1.0])
+    first, rest = path_between(whole.points, 0.0, 50.0), path_between(whole.points, 50.0, whole.length)
+    corner = (slice(0, round(12.0 / PAPER.cell)), slice(0, round(12.0 / PAPER.cell)))
+    short = []
+    for run_up in (LEAD, float(start_run_ups(robot, start, LEAD))):
+        routes = [np.vstack([robot, with_run_up(first, run_up)]), rest]
+        lack, _, _ = simulate_routes(PAPER, routes, np.array([robot, rest[0]]), LOOKAHEAD)
+        short.append(int((lack[corner] > 0.0).sum()))
+    assert short[0] > 0 and short[1] == 0
