@@ -19,9 +19,11 @@ straight pass at full speed wastes least. So:
    (:func:`model.routes.bottleneck_assignment` on scipy's ``linear_sum_assignment``), and the pieces
    are resized until transit, run-up and flight take every robot about as long
    (:func:`model.routes.balanced_routes`): the team finishes with its slowest robot. The robot whose
-   piece ends at the centre gets less spiral, to take the passes the small innermost ring leaves there;
-   and of the spiral's 8 symmetries (which corner it starts from, which way it turns) the one that
-   finishes soonest is flown.
+   piece ends at the centre gets less spiral, to take the passes the small innermost ring leaves there.
+   On the 2 of the spiral's 8 symmetries (which corner it starts from, which way it turns) that finish
+   soonest so, the order in which robots take pieces is then improved by local search and the pieces cut
+   exactly for it (:mod:`model.piece_order`); the sooner is flown. Pieces after the first are entered
+   2 units back along the spiral, and a robot starting near the spiral's start gets twice the run-up.
 3. **Touch-ups.** The routes are flown once here, as the engine will fly them
    (:func:`model.touch_ups.simulate_routes`), and every group of cells they will leave short gets an
    orbit, a small circle whose forward camera sweeps all around it, appended to the route of the robot
