@@ -1,6 +1,7 @@
-"""How long the anicov controller's first plan takes: the spiral's 8 symmetries balanced, then the routes
-flown once to foresee what they leave short and the orbits over it (model.touch_ups). In realtime the
-team waits this long for its first carrots; in lockstep and in the engine it is paid once per run.
+"""How long the anicov controller's first plan takes: the spiral's 8 symmetries balanced, the order robots
+take the pieces of the 2 soonest searched (model.piece_order), then the routes flown once to foresee what
+they leave short and the orbits over it (model.touch_ups). In realtime the team waits this long for its
+first carrots; in lockstep and in the engine it is paid once per run.
 
     .venv/bin/python bench/bench_planner.py
 """

@@ -18,6 +18,7 @@ average, this search's 2.95.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -147,20 +148,27 @@ def cuts_for(order: np.ndarray, finish: float, positions: np.ndarray, spiral: Sp
 
 
 def neighbours(order: np.ndarray) -> np.ndarray:
-    """Every order one swap of two robots, or one move of a robot to another place, from ``order``."""
-    agents = len(order)
+    """Every order one swap of two robots, or one move of a robot to another place, from ``order``: the
+    swaps (i, j), i < j, then the moves of place i to place j, |i - j| > 1 (to i +- 1 is a swap)."""
+    return order[_neighbour_places(len(order))]
+
+
+@functools.cache
+def _neighbour_places(agents: int) -> np.ndarray:
+    """:func:`neighbours` as places: row r holds, for each place, which place of the order it takes."""
+    places = np.arange(agents)
     found = []
     for i in range(agents):
         for j in range(i + 1, agents):
-            swapped = order.copy()
-            swapped[i], swapped[j] = order[j], order[i]
+            swapped = places.copy()
+            swapped[i], swapped[j] = j, i
             found.append(swapped)
     for i in range(agents):
-        rest = np.delete(order, i)
+        rest = np.delete(places, i)
         for j in range(agents):
-            if abs(j - i) > 1:  # to i +- 1 is a swap, above
-                found.append(np.insert(rest, j, order[i]))
-    return np.array(found, dtype=order.dtype).reshape(-1, agents)
+            if abs(j - i) > 1:
+                found.append(np.insert(rest, j, i))
+    return np.array(found, dtype=np.intp).reshape(-1, agents)
 
 
 def improved_order(order: np.ndarray, positions: np.ndarray, spiral: Spiral) -> tuple[np.ndarray, float]:
