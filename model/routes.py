@@ -221,7 +221,7 @@ def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, l
         routes, finish, owners = balanced_routes_on(scenario, path, positions, lead)
         tried.append((finish, path, routes, owners))
     soonest = sorted(range(len(tried)), key=lambda k: tried[k][0])  # stable: the first on a tie
-    if scenario.agents == 1:
+    if scenario.agents == 1 or Route.of(tried[soonest[0]][1]).length <= 0.0:  # alone, or a spiral of one point
         return tried[soonest[0]][2]
     best, best_finish = None, math.inf
     for k in soonest[:ORDERED_VARIANTS]:

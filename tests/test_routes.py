@@ -193,3 +193,11 @@ def test_the_symmetries_of_a_non_square_domain_do_not_check_its_scenario_again()
     variants = spiral_variants(scenario, best_lane_spacing(scenario))
     assert len(variants) == 8
     assert all(variant[:, 0].max() < 100.0 and variant[:, 1].max() < 60.0 for variant in variants)
+
+
+def test_a_domain_within_one_pass_of_its_centre_sends_every_robot_to_the_one_point_of_its_spiral():
+    scenario = PAPER.with_overrides(domain=[4.0, 4.0], agents=2, controller="anicov")
+    spacing = best_lane_spacing(scenario)
+    positions = np.array([[1.0, 1.0], [3.0, 3.0]])
+    routes = balanced_routes(scenario, spacing, positions, lead_in(scenario, spacing))
+    assert [route.tolist() for route in routes] == [[[1.0, 1.0], [2.0, 2.0]], [[3.0, 3.0], [2.0, 2.0]]]
