@@ -4,12 +4,16 @@ next, and where each piece ends, so that the team finishes as soon as it can.
 Beyond the paper (docs/controller.md has the measurements). Robots in a given order take consecutive pieces
 of the spiral from its start; robot k's piece begins where robot k - 1's ends. For a finish time T, each
 piece is as long as T less its robot's transit to where the piece begins (the first piece: to its run-up,
-and the run-up itself; the piece that ends at the spiral's end: also the centre's allowance): the pieces
-then take every robot exactly T, and the least T at which they reach the spiral's end is the order's
-finish (:func:`order_finishes`, by bisection, for many orders at once). A robot whose transit alone is
-longer than T flies no piece. The order is improved by local search (:func:`improved_order`): every swap
-of two robots and every move of one robot to another place in the order, the best taken while one is
-better. :func:`model.routes.balanced_routes` starts it from the order of its resized pieces: on the paper's
+and the run-up itself; after the first: to :attr:`Spiral.overlap` before it, and the overlap): the pieces
+then take every robot exactly T, and the least T at which they reach the spiral's end with the centre's
+allowance to spare is the order's finish (:func:`order_finishes`, by bisection, for many orders at once).
+The allowance may be shared: a robot that reaches the end with less than the allowance to spare leaves the
+rest to the next in the order, who flies no spiral, goes to the centre and is counted what it has left
+(on the paper's square at N = 30 most plans end so: two robots share the centre's orbit and passes). A
+robot whose transit alone is longer than T flies no piece, nor do the robots after the end is reached; they
+take passes from the start. The order is improved by local search (:func:`improved_order`): every swap of
+two robots and every move of one robot to another place in the order, the soonest (as far as a bracket
+20 % under the best so far tells) taken while one is sooner. :func:`model.routes.balanced_routes` starts it from the order of its resized pieces: on the paper's
 square (16 seeds, 2026-12-04) that alone made N = 20 2.965 -> 2.906 t* and N = 30 3.395 -> 3.216, and
 N = 2 - 10 moved by less than 0.01. Resizing the pieces in rounds, robots reassigned in each, did not settle
 where thirty robots and thirty pieces are all a transit apart: their estimated finish was 3.69 t*_30 on
@@ -79,8 +83,9 @@ def order_finishes(
 ) -> np.ndarray:
     """The least finish T of each order (``orders``: (M, N) robot indices; returns (M,)): the least T at
     which consecutive pieces, each T less its robot's transit to where it begins (and the first's run-up),
-    reach the spiral's end, the robot reaching it also flying the allowance within T. ``below``: only
-    whether T lies under these is asked (the bracket starts 20 % under them, fewer halvings)."""
+    reach the spiral's end with the centre's allowance to spare (shared with the next robot, see the
+    module). ``below``: only whether T lies under these is asked (the bracket starts 20 % under them, fewer
+    halvings)."""
     count = len(orders)
     at = positions[orders]  # (M, N, 2)
     first = spiral.first_transits(at)  # (M, N): were each robot to start the spiral
@@ -172,8 +177,9 @@ def _neighbour_places(agents: int) -> np.ndarray:
 
 
 def improved_order(order: np.ndarray, positions: np.ndarray, spiral: Spiral) -> tuple[np.ndarray, float]:
-    """(order, its finish): from ``order``, the best of all its :func:`neighbours` while it finishes
-    sooner (steepest descent, at most :data:`MAX_ROUNDS` rounds)."""
+    """(order, its finish): from ``order``, the soonest of all its :func:`neighbours` while it finishes
+    sooner (steepest descent, at most :data:`MAX_ROUNDS` rounds; neighbours more than 20 % sooner than the
+    best so far all look alike to the rough bracket, and the first of them is taken)."""
     order = np.asarray(order)
     best = float(order_finishes(order[None, :], positions, spiral)[0])
     for _ in range(MAX_ROUNDS):

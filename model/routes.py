@@ -237,8 +237,10 @@ def ordered_routes(
     scenario: Scenario, spiral: np.ndarray, positions: np.ndarray, lead: float, order: np.ndarray
 ) -> tuple[list[np.ndarray], float]:
     """Routes on ``spiral`` for the best order near ``order`` (:func:`model.piece_order.improved_order`)
-    and its finish: the pieces cut so that each takes its robot the same time; a robot left without a
-    piece (its transit alone too long) has a route of its own position, and takes passes from the start."""
+    and its finish: the pieces cut so that each takes its robot the same time, each after the first entered
+    :data:`SEAM_OVERLAP` back along the spiral. A robot left without a piece (its transit alone too long,
+    or after the spiral's end is reached) has a route of its own position and takes passes from the start;
+    one sharing the centre's allowance (:mod:`model.piece_order`) has a route to the spiral's end."""
     whole = Route.of(spiral)
     allowance = CENTRE_ALLOWANCE_LEADS * lead if scenario.agents > 1 else 0.0
     cut_on = Spiral(whole.points, whole.along, lead, allowance, SEAM_OVERLAP)
@@ -255,8 +257,9 @@ def ordered_routes(
 def balanced_routes_on(
     scenario: Scenario, spiral: np.ndarray, positions: np.ndarray, lead: float
 ) -> tuple[list[np.ndarray], float, list[int]]:
-    """Routes on ``spiral``, their estimated finish and each piece's robot, in the spiral's order. From equal pieces, each round assigns robots to
-    pieces (:func:`assign_pieces`), then moves every piece's length halfway to the one that makes
+    """Routes on ``spiral``, their estimated finish and each piece's robot, in the spiral's order (a robot
+    alone flies these routes; for a team they are where :func:`ordered_routes` starts, and its routes are
+    flown). From equal pieces, each round assigns robots to pieces (:func:`assign_pieces`), then moves every piece's length halfway to the one that makes
     transit, run-up and flight the same for all; the routes with the earliest estimated finish (longest
     transit + run-up + piece) are kept (the first on a near-tie). The last piece, which ends on the
     spiral's innermost ring, counts :data:`CENTRE_ALLOWANCE_LEADS` run-ups more: on a square that ring's

@@ -109,7 +109,7 @@ def test_balanced_pieces_make_every_robot_finish_closer_together_than_equal_ones
     assert np.delete(flown, at_centre).min() - flown[at_centre] > CENTRE_ALLOWANCE_LEADS * lead - 2.0
 
 
-def test_the_spiral_is_flown_in_whichever_of_its_8_symmetries_finishes_first():
+def test_the_spiral_is_flown_on_one_of_the_soonest_of_its_8_symmetries_with_every_robot_done_at_once():
     scenario = PAPER.with_overrides(agents=4, domain=[100.0, 60.0])
     spacing, lead = best_lane_spacing(scenario), lead_in(scenario, best_lane_spacing(scenario))
     variants = spiral_variants(scenario, spacing)
@@ -139,7 +139,7 @@ def test_the_spiral_is_flown_in_whichever_of_its_8_symmetries_finishes_first():
     assert len(flown) == 1 and flown[0] in soonest
     done = _finishes(chosen, lead, variants[flown[0]][-1])
     assert done == pytest.approx([done[0]] * 4, abs=1e-6)
-    assert done[0] <= min(finishes) + 3 * SEAM_OVERLAP + 1e-6
+    assert done[0] <= min(finishes) + 2 * SEAM_OVERLAP + 1e-6  # each overlap costs at most twice its length
 
 
 def _enters(route: np.ndarray, variant: np.ndarray) -> bool:
