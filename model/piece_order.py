@@ -8,22 +8,23 @@ and the run-up itself; after the first: to :attr:`Spiral.overlap` before it, and
 then take every robot exactly T, and the least T at which they reach the spiral's end with the centre's
 allowance to spare is the order's finish (:func:`order_finishes`, by bisection, for many orders at once).
 The allowance may be shared: a robot that reaches the end with less than the allowance to spare leaves the
-rest to the next in the order, who flies no spiral, goes to the centre and is counted what it has left
-(on the paper's square at N = 30 most plans end so: two robots share the centre's orbit and passes). A
-robot whose transit alone is longer than T flies no piece, nor do the robots after the end is reached; they
-take passes from the start. The order is improved by local search (:func:`improved_order`): every swap of
-two robots and every move of one robot to another place in the order, the soonest (as far as a bracket
-20 % under the best so far tells) taken while one is sooner. :func:`model.routes.balanced_routes` starts it from the order of its resized pieces: on the paper's
-square (16 seeds, 2026-12-04) that alone made N = 20 2.965 -> 2.906 t* and N = 30 3.395 -> 3.216, and
-N = 2 - 10 moved by less than 0.01. Resizing the pieces in rounds, robots reassigned in each, did not settle
-where thirty robots and thirty pieces are all a transit apart: their estimated finish was 3.69 t*_30 on
-average, this search's 2.95.
+rest to the next in the order, who flies no spiral, goes to the centre and is counted what it has left (on
+the paper's square at N = 30 most plans end so: two robots share the centre's orbit and passes). A robot
+whose transit alone is longer than T flies no piece, nor do the robots after the end is reached; they take
+passes from the start. The order is improved by local search (:func:`improved_order`): every swap of two
+robots and every move of one robot to another place in the order, the soonest (as far as a bracket 20 %
+under the best so far tells) taken while one is sooner. :func:`model.routes.balanced_routes` starts it from
+the order of its resized pieces: on the paper's square (16 seeds, 2026-12-04) that alone made N = 20 2.965
+-> 2.906 t* and N = 30 3.395 -> 3.216, and N = 2 - 10 moved by less than 0.01. Resizing the pieces in
+rounds, robots reassigned in each, did not settle where thirty robots and thirty pieces are all a transit
+apart: their estimated finish was 3.69 t*_30 on average, this search's 2.95.
 """
 
 from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -53,18 +54,25 @@ class Spiral:
     def length(self) -> float:
         return float(self.along[-1])
 
-    def entered(self, cut: float) -> float:
-        """Where (arc length) a piece cut at ``cut`` (> 0) is entered: :attr:`overlap` before it."""
-        return max(min(cut, self.length) - self.overlap, 0.0)
+    def entered(self, cut: Any) -> Any:
+        """Where (arc length) a piece cut at ``cut`` (> 0; a float or an array) is entered: :attr:`overlap`
+        before it, no farther back than the spiral's start, the cut held to the spiral's end."""
+        return np.maximum(np.minimum(cut, self.length) - self.overlap, 0.0)
 
     def first_transits(self, positions: np.ndarray) -> np.ndarray:
         """The way (units) from each of ``positions`` (..., 2) to the spiral's first point: to where its
-        run-up begins (:func:`start_run_ups`), then the run-up."""
-        heading = self.points[1] - self.points[0]
-        heading = heading / max(float(np.linalg.norm(heading)), 1e-300)
+        run-up begins (:func:`start_run_ups`, :func:`run_up_entries`), then the run-up."""
         run_up = start_run_ups(positions, self.points[0], self.lead)
-        entry = self.points[0] - run_up[..., None] * heading
-        return np.linalg.norm(positions - entry, axis=-1) + run_up
+        return np.linalg.norm(positions - run_up_entries(self.points, run_up), axis=-1) + run_up
+
+
+def run_up_entries(path: np.ndarray, run_ups: np.ndarray | float) -> np.ndarray:
+    """Where a run-up of each of ``run_ups`` before ``path``'s first point begins, back along its first
+    stretch ((..., 2) for (...) run-ups): the one definition of the run-up's start, for the estimate here
+    and the routes flown (:func:`model.routes.with_run_up`)."""
+    heading = path[1] - path[0]
+    heading = heading / max(float(np.linalg.norm(heading)), 1e-300)
+    return path[0] - np.asarray(run_ups)[..., None] * heading
 
 
 def start_run_ups(positions: np.ndarray, start: np.ndarray, lead: float) -> np.ndarray:
@@ -116,7 +124,7 @@ def _reaches_end(at: np.ndarray, first: np.ndarray, spiral: Spiral, finish: np.n
     cut = np.zeros(count)
     reached = np.zeros(count, dtype=bool)
     for k in range(agents):
-        entered = np.maximum(np.minimum(cut, spiral.length) - spiral.overlap, 0.0)
+        entered = spiral.entered(cut)
         x = np.interp(entered, spiral.along, spiral.points[:, 0])
         y = np.interp(entered, spiral.along, spiral.points[:, 1])
         # At a cut of 0 this robot starts the spiral (the robots before it, if any, took nothing: their
@@ -139,7 +147,7 @@ def cuts_for(order: np.ndarray, finish: float, positions: np.ndarray, spiral: Sp
         if cut == 0.0:  # the spiral's first piece
             transit = float(spiral.first_transits(positions[robot]))
         else:
-            entered = spiral.entered(cut)
+            entered = float(spiral.entered(cut))
             transit = float(np.linalg.norm(positions[robot] - point_along(spiral.points, spiral.along, entered)))
             transit += min(cut, spiral.length) - entered
         if cut + finish - transit - spiral.allowance >= spiral.length - 1e-9:

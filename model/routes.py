@@ -26,7 +26,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment, minimize_scalar
 
 from model.metrics import pass_reach, straight_pass_coverage
-from model.piece_order import Spiral, cuts_for, improved_order, start_run_ups
+from model.piece_order import Spiral, cuts_for, improved_order, run_up_entries, start_run_ups
 from model.scenario import Scenario
 from model.zigzag import path_between, point_along
 
@@ -236,14 +236,14 @@ def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, l
 def ordered_routes(
     scenario: Scenario, spiral: np.ndarray, positions: np.ndarray, lead: float, order: np.ndarray
 ) -> tuple[list[np.ndarray], float]:
-    """Routes on ``spiral`` for the best order near ``order`` (:func:`model.piece_order.improved_order`)
-    and its finish: the pieces cut so that each takes its robot the same time, each after the first entered
-    :data:`SEAM_OVERLAP` back along the spiral. A robot left without a piece (its transit alone too long,
-    or after the spiral's end is reached) has a route of its own position and takes passes from the start;
-    one sharing the centre's allowance (:mod:`model.piece_order`) has a route to the spiral's end."""
+    """Routes on ``spiral`` for a team (N > 1) with the best order near ``order``
+    (:func:`model.piece_order.improved_order`) and its finish: the pieces cut so that each takes its robot
+    the same time, each after the first entered :data:`SEAM_OVERLAP` back along the spiral. A robot left
+    without a piece (its transit alone too long, or after the spiral's end is reached) has a route of its
+    own position and takes passes from the start; one sharing the centre's allowance
+    (:mod:`model.piece_order`) has a route to the spiral's end."""
     whole = Route.of(spiral)
-    allowance = CENTRE_ALLOWANCE_LEADS * lead if scenario.agents > 1 else 0.0
-    cut_on = Spiral(whole.points, whole.along, lead, allowance, SEAM_OVERLAP)
+    cut_on = Spiral(whole.points, whole.along, lead, CENTRE_ALLOWANCE_LEADS * lead, SEAM_OVERLAP)
     order, finish = improved_order(order, positions, cut_on)
     routes = [positions[robot][None, :].copy() for robot in range(len(positions))]
     for robot, start, end in cuts_for(order, finish, positions, cut_on):
@@ -259,15 +259,16 @@ def balanced_routes_on(
 ) -> tuple[list[np.ndarray], float, list[int]]:
     """Routes on ``spiral``, their estimated finish and each piece's robot, in the spiral's order (a robot
     alone flies these routes; for a team they are where :func:`ordered_routes` starts, and its routes are
-    flown). From equal pieces, each round assigns robots to pieces (:func:`assign_pieces`), then moves every piece's length halfway to the one that makes
-    transit, run-up and flight the same for all; the routes with the earliest estimated finish (longest
-    transit + run-up + piece) are kept (the first on a near-tie). The last piece, which ends on the
-    spiral's innermost ring, counts :data:`CENTRE_ALLOWANCE_LEADS` run-ups more: on a square that ring's
-    sides are shorter than a run-up and it leaves part of the centre to passes (on the paper's square at
-    N = 1: three, 70 time units), which its robot, near them, takes while the others finish (4 seeds,
-    with the 8 symmetries: N = 2 2.56 -> 2.47 t*, N = 4 2.67 -> 2.63, N = 10 3.11 -> 2.86; without it the
-    team waited for one robot's passes at the centre). Measured on the 200 x 50 strip too, whose
-    innermost ring is long and thin (4 seeds): N = 10 1.82 -> 1.78 t*, within 0.01 at N = 1, 4 and 30."""
+    flown). From equal pieces, each round assigns robots to pieces (:func:`assign_pieces`), then moves every
+    piece's length halfway to the one that makes transit, run-up and flight the same for all; the routes
+    with the earliest estimated finish (longest transit + run-up + piece) are kept (the first on a
+    near-tie). The last piece, which ends on the spiral's innermost ring, counts
+    :data:`CENTRE_ALLOWANCE_LEADS` run-ups more: on a square that ring's sides are shorter than a run-up and
+    it leaves part of the centre to passes (on the paper's square at N = 1: three, 70 time units), which its
+    robot, near them, takes while the others finish (4 seeds, with the 8 symmetries: N = 2 2.56 -> 2.47 t*,
+    N = 4 2.67 -> 2.63, N = 10 3.11 -> 2.86; without it the team waited for one robot's passes at the
+    centre). Measured on the 200 x 50 strip too, whose innermost ring is long and thin (4 seeds): N = 10
+    1.82 -> 1.78 t*, within 0.01 at N = 1, 4 and 30."""
     whole = Route.of(spiral)
     total = whole.length
     if total <= 0.0:  # a domain within 2·d100 on both sides: one point, every robot goes there
@@ -299,9 +300,7 @@ def balanced_routes_on(
 
 def with_run_up(piece: np.ndarray, lead: float) -> np.ndarray:
     """A piece entered ``lead`` before its first point, along its first stretch (the camera looks ahead)."""
-    direction = piece[1] - piece[0]
-    direction = direction / max(float(np.linalg.norm(direction)), 1e-300)
-    return np.vstack([piece[0] - lead * direction, piece])
+    return np.vstack([run_up_entries(piece, lead), piece])
 
 
 def bottleneck_assignment(cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -324,17 +323,15 @@ def bottleneck_assignment(cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def assign_pieces(pieces: list[np.ndarray], positions: np.ndarray, lead: float, with_owners: bool = False) -> Any:
     """Each robot's route: its start, then its piece. The first piece (the spiral's start) is entered
-    ``lead`` before its first point (twice that for a robot starting near it: :func:`start_run_ups`); the others start where the piece before them ends: a point beside
-    the spiral just past a seam is seen by the camera of the robot ending there from behind, as a run-up
-    would (measured, 8 seeds, without a run-up at the seams: N = 4 2.65 -> 2.61 t*, N = 10 2.98 -> 2.88,
-    N = 30 3.59 -> 3.41). Pieces are flown the way the spiral goes (inward: flown outward, a ring's
-    corners leave gaps the next ring does not close); the assignment minimises the longest transit,
-    then the total. ``with_owners``: also each piece's robot."""
+    ``lead`` before its first point (twice that for a robot starting near it: :func:`start_run_ups`); the
+    others start where the piece before them ends: a point beside the spiral just past a seam is seen by the
+    camera of the robot ending there from behind, as a run-up would (measured, 8 seeds, without a run-up at
+    the seams: N = 4 2.65 -> 2.61 t*, N = 10 2.98 -> 2.88, N = 30 3.59 -> 3.41). Pieces are flown the way
+    the spiral goes (inward: flown outward, a ring's corners leave gaps the next ring does not close); the
+    assignment minimises the longest transit, then the total. ``with_owners``: also each piece's robot."""
     run_ups = start_run_ups(positions, pieces[0][0], lead)  # the first piece's, each robot's own
     transit = np.array([[np.linalg.norm(piece[0] - p) for piece in pieces] for p in positions])
-    transit[:, 0] = [
-        np.linalg.norm(with_run_up(pieces[0], run_up)[0] - p) for run_up, p in zip(run_ups, positions, strict=True)
-    ]
+    transit[:, 0] = np.linalg.norm(run_up_entries(pieces[0], run_ups) - positions, axis=1)
     robots, chosen = bottleneck_assignment(transit)
     routes: list[np.ndarray] = [np.zeros((0, 2))] * len(positions)
     owners = [0] * len(pieces)
