@@ -73,21 +73,45 @@ def global_law_around_walls(
 
 @njit(cache=True)
 def pursuit_law(
-    x: float, y: float, theta: float, objective_x: float, objective_y: float, k_v: float, k_omega: float, dt: float
+    x: float,
+    y: float,
+    theta: float,
+    objective_x: float,
+    objective_y: float,
+    k_v: float,
+    k_omega: float,
+    dt: float,
+    weave_amplitude: float = 0.0,
+    weave_wavelength: float = 1.0,
 ) -> tuple[float, float]:
     """Beyond the paper, the ``anicov`` controller (docs/controller.md): drive at the objective, a carrot
     on the planned path (pure pursuit, Coulter 1992), at full speed until the carrot is within one step,
     with eq. 15-16's heading terms: v = k_v min(1, d/(k_v dt)) (1 − 2|e_θ|/π), ω = k_ω e_θ, e_θ the
     wrapped heading error to the carrot, d its distance. |v| ≤ k_v and |ω| ≤ π k_ω, the paper's bounds
-    (a carrot behind the robot makes it back up while it turns, as eq. 15 does)."""
+    (a carrot behind the robot makes it back up while it turns, as eq. 15 does).
+
+    With a weave (``weave_amplitude`` A > 0, :mod:`model.weave`): the heading is steered to the carrot's
+    bearing plus A sin(2π s/λ), s the robot's coordinate along the axis nearer the carrot's direction (the
+    spiral's sides are axis-parallel; a stateless phase, the same in every process), with the reference's
+    own rate fed forward, ω = k_ω e_θ + A cos(2π s/λ) (2π/λ) ds/dt, held to |ω| ≤ π k_ω; the speed drops
+    only for the part of the bearing error beyond A: v = k_v min(1, d/(k_v dt)) (1 − 2 max(0, |e_b| − A)/π).
+    With A = 0 this is the law above."""
     dx = objective_x - x
     dy = objective_y - y
-    e_theta = wrap_angle(math.atan2(dy, dx) - theta)
+    bearing = math.atan2(dy, dx)
+    along_x = abs(dx) >= abs(dy)
+    phase = 2.0 * math.pi * (x if along_x else y) / weave_wavelength
+    e_theta = wrap_angle(bearing + weave_amplitude * math.sin(phase) - theta)
     arrive = min(1.0, math.sqrt(dx * dx + dy * dy) / (k_v * dt))
+    beyond_weave = max(0.0, abs(wrap_angle(bearing - theta)) - weave_amplitude)
     # Held at -1: at |e_θ| one ulp from π the product (2/π)|e_θ| rounds past 2 (hypothesis found
     # v = -1.0000000000000004 at θ = 3.1415926535897927 with the carrot straight behind).
-    heading = max(-1.0, 1.0 - (2.0 / math.pi) * abs(e_theta))
-    return k_v * arrive * heading, k_omega * e_theta
+    heading = max(-1.0, 1.0 - (2.0 / math.pi) * beyond_weave)
+    v = k_v * arrive * heading
+    travel_rate = v * (math.cos(theta) if along_x else math.sin(theta))  # ds/dt
+    feed_forward = weave_amplitude * math.cos(phase) * (2.0 * math.pi / weave_wavelength) * travel_rate
+    bound = math.pi * k_omega
+    return v, min(bound, max(-bound, k_omega * e_theta + feed_forward))
 
 
 @njit(cache=True)

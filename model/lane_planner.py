@@ -49,9 +49,10 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from model.objectives import BlobObjectives
-from model.routes import Route, balanced_routes, best_lane_spacing, lead_in
+from model.routes import Route, balanced_routes, lead_in
 from model.scenario import Scenario
 from model.touch_ups import TouchUp, blob_labels, with_touch_ups
+from model.weave import sweep_of
 
 Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
 
@@ -96,7 +97,8 @@ class LanePlanner:
     touch_ups: dict[int, list[TouchUp]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        self.spacing = best_lane_spacing(self.scenario)
+        self.sweep = sweep_of(self.scenario)
+        self.spacing = self.sweep.spacing
         self.lead = lead_in(self.scenario, self.spacing)
 
     def plan(self, lack: np.ndarray, positions: np.ndarray, members: list[int] | None = None) -> np.ndarray:
@@ -105,7 +107,10 @@ class LanePlanner:
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
         if not self.routes:
             start = self._all(ids, positions)
-            routes = balanced_routes(self.scenario, self.spacing, start, self.lead)
+            sweep = self.sweep
+            routes = balanced_routes(
+                self.scenario, self.spacing, start, self.lead, sweep.reach, sweep.edge, sweep.centre_leads
+            )
             routes, touch_ups = with_touch_ups(self.scenario, routes, start, LOOKAHEAD, self.spacing)
             for agent, route in zip(range(self.scenario.agents), routes, strict=True):
                 self.routes[agent] = Route.of(route)

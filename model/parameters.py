@@ -16,11 +16,13 @@ from model.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
 from model.scenario_safety import point_speed
 from model.step import LawParameters
+from model.weave import sweep_of
 from model.world import world_of
 
 
 def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParameters:
     """The control and sensing parameters of a scenario."""
+    sweep = sweep_of(scenario) if scenario.controller == "anicov" else None
     return LawParameters(
         sensing_range=scenario.range,
         half_angle=scenario.half_angle,
@@ -34,6 +36,8 @@ def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParamete
         literal_heading=scenario.controller == "paper-literal",
         literal_omega=scenario.controller in ("paper-literal", "paper-eq16"),
         pursuit=scenario.controller == "anicov",
+        weave_amplitude=sweep.amplitude if sweep else 0.0,
+        weave_wavelength=sweep.wavelength if sweep else 1.0,
     )
 
 

@@ -149,20 +149,25 @@ class Route:
         cv2.polylines(canvas, [np.round(line).astype(np.int32)], False, 1, thickness=width)
 
 
-def spiral_path(scenario: Scenario, spacing: float) -> np.ndarray:
-    """The one-robot sweep: a rectangular spiral inward, as a polyline (K, 2). Its outer ring lies d100
+def spiral_path(
+    scenario: Scenario, spacing: float, reach: float | None = None, edge: float | None = None
+) -> np.ndarray:
+    """The one-robot sweep: a rectangular spiral inward, as a polyline (K, 2). Its outer ring lies ``edge``
     inside the domain's edges; its rings are evenly spaced, at most ``spacing`` apart, so that the
-    innermost one is at most d100 from the domain's centre line (one pass brings Λ* that far): a
-    spiral whose last ring stopped short would leave its centre to slow passes after it."""
+    innermost one is at most ``reach`` from the domain's centre line (one pass brings Λ* that far): a
+    spiral whose last ring stopped short would leave its centre to slow passes after it. ``reach`` and
+    ``edge`` default to d100, a straight pass's (:func:`model.weave.sweep_of` gives a weave's)."""
     width, height = scenario.domain
-    d100 = pass_reach(scenario)
-    return spiral_in(width, height, d100, spacing)
+    reach = pass_reach(scenario) if reach is None else reach
+    return spiral_in(width, height, reach, spacing, reach if edge is None else edge)
 
 
-def spiral_in(width: float, height: float, d100: float, spacing: float) -> np.ndarray:
-    """:func:`spiral_path` of a ``width`` x ``height`` rectangle whose one pass brings Λ* ``d100`` aside."""
-    first = min(d100, width / 2.0, height / 2.0)
-    inward = min(width, height) / 2.0 - 2.0 * first  # from the outer ring to where the innermost may be
+def spiral_in(width: float, height: float, d100: float, spacing: float, edge: float | None = None) -> np.ndarray:
+    """:func:`spiral_path` of a ``width`` x ``height`` rectangle whose one pass brings Λ* ``d100`` aside, the
+    outer ring ``edge`` (default ``d100``) inside its edges."""
+    first = min(d100 if edge is None else edge, width / 2.0, height / 2.0)
+    innermost = min(d100, width / 2.0, height / 2.0)
+    inward = min(width, height) / 2.0 - (first + innermost)  # from the outer ring to where the innermost may be
     rings = max(0, math.ceil(inward / spacing - 1e-9))
     step = inward / rings if rings else 0.0
     points: list[tuple[float, float]] = []
@@ -189,14 +194,17 @@ def cut(whole: Route, cuts: np.ndarray) -> list[np.ndarray]:
     return [path_between(whole.points, low, high) for low, high in itertools.pairwise(cuts)]
 
 
-def spiral_variants(scenario: Scenario, spacing: float) -> list[np.ndarray]:
+def spiral_variants(
+    scenario: Scenario, spacing: float, reach: float | None = None, edge: float | None = None
+) -> list[np.ndarray]:
     """:func:`spiral_path` in each of the domain rectangle's 8 symmetries (started from each corner, either
     way round): the same rings, flown inward, their starts in other places, each ending where the spiral
     does (on the innermost ring)."""
     width, height = scenario.domain
-    d100 = pass_reach(scenario)
-    along_x = spiral_in(width, height, d100, spacing)
-    along_y = spiral_in(height, width, d100, spacing)[:, ::-1]  # the transposed rectangle's, transposed back
+    reach = pass_reach(scenario) if reach is None else reach
+    edge = reach if edge is None else edge
+    along_x = spiral_in(width, height, reach, spacing, edge)
+    along_y = spiral_in(height, width, reach, spacing, edge)[:, ::-1]  # the transposed rectangle's, transposed back
     variants = []
     for path in (along_x, along_y):
         for flip_x, flip_y in itertools.product((False, True), repeat=2):
@@ -209,7 +217,15 @@ def spiral_variants(scenario: Scenario, spacing: float) -> list[np.ndarray]:
     return variants
 
 
-def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, lead: float) -> list[np.ndarray]:
+def balanced_routes(
+    scenario: Scenario,
+    spacing: float,
+    positions: np.ndarray,
+    lead: float,
+    reach: float | None = None,
+    edge: float | None = None,
+    centre_leads: float = CENTRE_ALLOWANCE_LEADS,
+) -> list[np.ndarray]:
     """Each robot's route, its piece sized so that the team finishes together. Every one of the spiral's 8
     symmetries (:func:`spiral_variants`) has its pieces resized (:func:`balanced_routes_on`): at random
     starts, the bottleneck transit depends on where the spiral starts and which way it turns (measured, 4
@@ -217,8 +233,8 @@ def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, l
     soonest so (the first on a tie), the order in which robots take pieces is improved and the pieces cut
     again for it (:func:`ordered_routes`), and the sooner is flown. A robot alone flies the soonest."""
     tried = []
-    for path in spiral_variants(scenario, spacing):
-        routes, finish, owners = balanced_routes_on(scenario, path, positions, lead)
+    for path in spiral_variants(scenario, spacing, reach, edge):
+        routes, finish, owners = balanced_routes_on(scenario, path, positions, lead, centre_leads)
         tried.append((finish, path, routes, owners))
     soonest = sorted(range(len(tried)), key=lambda k: tried[k][0])  # stable: the first on a tie
     if scenario.agents == 1 or Route.of(tried[soonest[0]][1]).length <= 0.0:  # alone, or a spiral of one point
@@ -226,7 +242,7 @@ def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, l
     best, best_finish = None, math.inf
     for k in soonest[:ORDERED_VARIANTS]:
         _, path, _, owners = tried[k]
-        routes, finish = ordered_routes(scenario, path, positions, lead, np.array(owners))
+        routes, finish = ordered_routes(scenario, path, positions, lead, np.array(owners), centre_leads)
         if finish < best_finish - TIE:
             best, best_finish = routes, finish
     assert best is not None
@@ -234,16 +250,22 @@ def balanced_routes(scenario: Scenario, spacing: float, positions: np.ndarray, l
 
 
 def ordered_routes(
-    scenario: Scenario, spiral: np.ndarray, positions: np.ndarray, lead: float, order: np.ndarray
+    scenario: Scenario,
+    spiral: np.ndarray,
+    positions: np.ndarray,
+    lead: float,
+    order: np.ndarray,
+    centre_leads: float = CENTRE_ALLOWANCE_LEADS,
 ) -> tuple[list[np.ndarray], float]:
     """Routes on ``spiral`` for a team (N > 1) with the best order near ``order``
     (:func:`model.piece_order.improved_order`) and its finish: the pieces cut so that each takes its robot
     the same time, each after the first entered :data:`SEAM_OVERLAP` back along the spiral. A robot left
     without a piece (its transit alone too long, or after the spiral's end is reached) has a route of its
     own position and takes passes from the start; one sharing the centre's allowance
-    (:mod:`model.piece_order`) has a route to the spiral's end."""
+    (:mod:`model.piece_order`) has a route to the spiral's end. The centre's allowance is ``centre_leads``
+    run-ups (:func:`balanced_routes_on`)."""
     whole = Route.of(spiral)
-    cut_on = Spiral(whole.points, whole.along, lead, CENTRE_ALLOWANCE_LEADS * lead, SEAM_OVERLAP)
+    cut_on = Spiral(whole.points, whole.along, lead, centre_leads * lead, SEAM_OVERLAP)
     order, finish = improved_order(order, positions, cut_on)
     routes = [positions[robot][None, :].copy() for robot in range(len(positions))]
     for robot, start, end in cuts_for(order, finish, positions, cut_on):
@@ -255,15 +277,19 @@ def ordered_routes(
 
 
 def balanced_routes_on(
-    scenario: Scenario, spiral: np.ndarray, positions: np.ndarray, lead: float
+    scenario: Scenario,
+    spiral: np.ndarray,
+    positions: np.ndarray,
+    lead: float,
+    centre_leads: float = CENTRE_ALLOWANCE_LEADS,
 ) -> tuple[list[np.ndarray], float, list[int]]:
     """Routes on ``spiral``, their estimated finish and each piece's robot, in the spiral's order (a robot
     alone flies these routes; for a team they are where :func:`ordered_routes` starts, and its routes are
     flown). From equal pieces, each round assigns robots to pieces (:func:`assign_pieces`), then moves every
     piece's length halfway to the one that makes transit, run-up and flight the same for all; the routes
     with the earliest estimated finish (longest transit + run-up + piece) are kept (the first on a
-    near-tie). The last piece, which ends on the spiral's innermost ring, counts
-    :data:`CENTRE_ALLOWANCE_LEADS` run-ups more: on a square that ring's sides are shorter than a run-up and
+    near-tie). The last piece, which ends on the spiral's innermost ring, counts ``centre_leads`` run-ups
+    more (:data:`CENTRE_ALLOWANCE_LEADS` for straight passes; :data:`model.weave.WEAVE_CENTRE_LEADS`): on a square that ring's sides are shorter than a run-up and
     it leaves part of the centre to passes (on the paper's square at N = 1: three, 70 time units), which its
     robot, near them, takes while the others finish (4 seeds, with the 8 symmetries: N = 2 2.56 -> 2.47 t*,
     N = 4 2.67 -> 2.63, N = 10 3.11 -> 2.86; without it the team waited for one robot's passes at the
@@ -275,7 +301,7 @@ def balanced_routes_on(
         return [np.vstack([position, whole.points[:1]]) for position in positions], 0.0, list(range(len(positions)))
     lengths = np.full(scenario.agents, total / scenario.agents)
     allowance = np.zeros(scenario.agents)
-    allowance[-1] = CENTRE_ALLOWANCE_LEADS * lead if scenario.agents > 1 else 0.0
+    allowance[-1] = centre_leads * lead if scenario.agents > 1 else 0.0
     best, best_finish, best_owners = None, math.inf, []
     for _ in range(BALANCING_ROUNDS + 1):
         cuts = np.concatenate([[0.0], np.cumsum(lengths)])

@@ -61,6 +61,7 @@ class Scenario:
     max_time: float = 10000.0
     controller: str = "paper"
     replan_period: float = 5.0
+    weave: bool = True  # anicov: robots weave their heading where that sweeps faster (model.weave); false: straight
     # Terrain (issue 11); the defaults are the paper's open world and leave every run as it was.
     map: str = ""  # a ROS map YAML, absolute (the file names it relative to itself); "" = none
     obstacles: tuple[tuple[tuple[float, float], ...], ...] = ()  # polygons [[x, y], ...]
@@ -119,7 +120,7 @@ class Scenario:
         for key in TERRAIN_KEYS:
             if getattr(self, key) == getattr(_OPEN_WORLD, key) or (key == "occlusion" and not self.has_terrain):
                 del values[key]
-        for key in (*UNIT_KEYS, *RADIO_DEFAULTS):
+        for key in ("weave", *UNIT_KEYS, *RADIO_DEFAULTS):
             if getattr(self, key) == getattr(_OPEN_WORLD, key):
                 del values[key]
         for key in SAFETY_DEFAULTS:
@@ -221,6 +222,10 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
                     f"scenario key 'controller': expected one of {', '.join(CONTROLLER_CHOICES)}, got {value!r}"
                 )
             resolved[key] = BEST_CONTROLLER if value == "best" else value
+        elif key == "weave":
+            if not isinstance(value, bool):
+                raise ScenarioError(f"scenario key 'weave': expected true or false, got {value!r}")
+            resolved[key] = value
         elif key == "half_angle_deg":
             angle = _number(key, value)
             if not 0.0 < angle < 180.0:

@@ -35,6 +35,8 @@ class LawParameters(NamedTuple):
     literal_heading: bool  # eq. 11 as printed
     literal_omega: bool  # eq. 16 as printed
     pursuit: bool = False  # the anicov controller: pure pursuit of a carrot (model.control.pursuit_law)
+    weave_amplitude: float = 0.0  # the anicov controller's weave, radians (model.weave; 0: straight)
+    weave_wavelength: float = 1.0  # its wavelength, units
 
 
 @njit(cache=True)
@@ -94,7 +96,10 @@ def decide_and_sense(
     teammates = teammates_in_view(ground, positions, me, x, y, law.sensing_range)
     e_omega, w_left, w_right, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, teammates)
     if law.pursuit:
-        v, omega = pursuit_law(x, y, theta, objective_x, objective_y, law.k_v, law.k_omega, law.dt)
+        v, omega = pursuit_law(
+            x, y, theta, objective_x, objective_y, law.k_v, law.k_omega, law.dt, law.weave_amplitude,
+            law.weave_wavelength,
+        )  # fmt: skip
         return v, omega, e_omega, row0, col0, ticks
     u_loc, theta_loc = local_law(e_omega, w_left, w_right, theta, law.half_angle)
     u_glo, theta_glo = global_law(x, y, objective_x, objective_y, law.sensing_range, law.literal_heading)

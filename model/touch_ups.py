@@ -89,7 +89,10 @@ def simulate_routes(
                 if route.done():
                     break
                 carrot = route.point_at(route.progress + lookahead)
-            v, omega = pursuit_law(x, y, theta, carrot[0], carrot[1], scenario.k_v, scenario.k_omega, scenario.dt)
+            v, omega = pursuit_law(
+                x, y, theta, carrot[0], carrot[1], law.k_v, law.k_omega, law.dt, law.weave_amplitude,
+                law.weave_wavelength,
+            )  # fmt: skip
             _, _, _, row0, col0, window = sense_wedge_among(
                 ticks, law.target_ticks, x, y, theta, law.sensing_range, law.half_angle, law.alpha_max,
                 law.dt, law.cell, ground, nobody,

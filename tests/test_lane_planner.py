@@ -13,7 +13,6 @@ from hypothesis import strategies as st
 from anicov.engine import run_scenario
 from model.control import pursuit_law
 from model.lane_planner import LOOKAHEAD, LanePlanner, blob_passes
-from model.routes import best_lane_spacing
 from model.scenario import Scenario, ScenarioError, load_scenario
 
 PAPER = Scenario()
@@ -62,11 +61,31 @@ def test_carrots_lead_each_robot_along_its_route_and_a_robot_with_nothing_left_s
 
 
 @settings(max_examples=300)
+@given(
+    st.floats(-50, 50),
+    st.floats(-50, 50),
+    st.floats(-math.pi, math.pi),
+    st.floats(-50, 50),
+    st.floats(-50, 50),
+    st.sampled_from([0.0, 0.3, 0.5, 0.6]),
+)
+@example(0.0, 1.0, 3.1415926535897927, 1.0, 1.0, 0.0)  # the carrot straight behind: (2/π)|e_θ| rounded past 2
+def test_the_pursuit_law_keeps_the_papers_velocity_bounds(x, y, theta, goal_x, goal_y, weave):
+    """With or without a weave (model.weave): eq. 15-16's bounds |v| ≤ k_v, |ω| ≤ π k_ω."""
+    v, omega = pursuit_law(x, y, theta, goal_x, goal_y, 1.0, 1.0, 0.1, weave, 3.5)
+    assert abs(v) <= 1.0 and abs(omega) <= math.pi + 1e-12
+
+
+@settings(max_examples=200)
 @given(st.floats(-50, 50), st.floats(-50, 50), st.floats(-math.pi, math.pi), st.floats(-50, 50), st.floats(-50, 50))
-@example(0.0, 1.0, 3.1415926535897927, 1.0, 1.0)  # the carrot straight behind: (2/π)|e_θ| rounded past 2
-def test_the_pursuit_law_keeps_the_papers_velocity_bounds(x, y, theta, goal_x, goal_y):
+def test_the_pursuit_law_without_a_weave_is_pure_pursuit(x, y, theta, goal_x, goal_y):
+    """Amplitude 0: v = k_v min(1, d/(k_v dt)) (1 - 2|e_θ|/π) (held at -k_v), ω = k_ω e_θ, as the straight
+    passes of the tables before the weave were flown."""
     v, omega = pursuit_law(x, y, theta, goal_x, goal_y, 1.0, 1.0, 0.1)
-    assert abs(v) <= 1.0 and abs(omega) <= math.pi + 1e-12  # eq. 15-16: |v| ≤ k_v, |ω| ≤ π k_ω
+    e_theta = math.atan2(math.sin(math.atan2(goal_y - y, goal_x - x) - theta), math.cos(math.atan2(goal_y - y, goal_x - x) - theta))
+    arrive = min(1.0, math.hypot(goal_x - x, goal_y - y) / 0.1)
+    assert v == pytest.approx(arrive * max(-1.0, 1.0 - 2.0 * abs(e_theta) / math.pi), abs=1e-9)
+    assert omega == pytest.approx(e_theta, abs=1e-9)
 
 
 def test_best_names_the_anicov_controller_which_knows_no_walls_and_plans_centrally():
@@ -90,7 +109,7 @@ def test_a_rebuilt_planner_puts_each_robot_back_on_its_route_or_frees_it():
     now = np.array([lost.routes[agent].point_at(0.4 * lost.routes[agent].length) for agent in range(3)])
     now[0] += [0.3, -0.2]  # a robot is never exactly on its path
     now[1] = lost.routes[0].point_at(0.9 * lost.routes[0].length)  # over on agent 0's piece: a pass
-    assert lost.routes[1].nearest(now[1])[0] > best_lane_spacing(scenario) / 2.0
+    assert lost.routes[1].nearest(now[1])[0] > lost.spacing / 2.0
     behind_2 = lost.routes[2].point_at(0.4 * lost.routes[2].length)
     rebuilt = LanePlanner(scenario)
     rebuilt.plan(lack, start)
@@ -98,9 +117,10 @@ def test_a_rebuilt_planner_puts_each_robot_back_on_its_route_or_frees_it():
         assert np.array_equal(rebuilt.routes[agent].points, lost.routes[agent].points)
     # Everything along agent 2's route from where it stands is covered: it had flown it.
     strip = np.zeros(scenario.grid_shape, dtype=bool)
+    half = math.ceil(lost.spacing / 2.0) + 1  # cells
     for distance in np.arange(0.4 * lost.routes[2].length, lost.routes[2].length, 0.5):
         x, y = lost.routes[2].point_at(distance)
-        strip[max(int(y) - 5, 0) : int(y) + 6, max(int(x) - 5, 0) : int(x) + 6] = True
+        strip[max(int(y) - half, 0) : int(y) + half + 1, max(int(x) - half, 0) : int(x) + half + 1] = True
     lack[strip] = 0.0
     rebuilt.resume(lack, np.vstack([now[:2], behind_2]), [0, 1, 2])
     assert math.isclose(rebuilt.routes[0].progress, 0.4 * lost.routes[0].length, abs_tol=0.5)

@@ -15,7 +15,8 @@ from model.routes import Route
 from model.scenario import Scenario
 from model.touch_ups import ORBIT_RADIUS, TouchUp, orbit, orbit_for, simulate_routes, with_touch_ups
 
-SMALL = Scenario().with_overrides(domain=[40.0, 40.0], agents=1, controller="anicov")
+SMALL = Scenario().with_overrides(domain=[40.0, 40.0], agents=1, controller="anicov", weave=False)
+"""Straight passes: the touch-ups' geometry below is the straight pass's (test_weave.py has the weave)."""
 
 
 def test_a_simulated_straight_pass_covers_d100_to_either_side_and_not_much_more():

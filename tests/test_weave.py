@@ -1,0 +1,94 @@
+"""model.weave: the anicov controller's passes, straight or weaving, their coverage profile and rings."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from model import lane_planner, weave
+from model.metrics import pass_reach, straight_pass_coverage
+from model.routes import best_lane_spacing
+from model.scenario import CARROT_PERIOD, Scenario, ScenarioError, load_scenario
+from model.touch_ups import simulate_routes
+from model.weave import MARGIN, WEAVE_CENTRE_LEADS, one_pass_reach, pass_profile, sweep_of, two_pass_spacing
+
+PAPER = Scenario().with_overrides(controller="anicov")
+WIDE = load_scenario(Path(__file__).resolve().parent.parent / "scenarios" / "wide.toml").with_overrides(
+    controller="anicov"
+)
+PLAN_STEPS = round(CARROT_PERIOD / PAPER.dt)
+
+
+def profile(scenario: Scenario, amplitude: float) -> tuple[np.ndarray, np.ndarray, float]:
+    return pass_profile(
+        amplitude, weave.WAVELENGTH_PER_RANGE * scenario.range, scenario.range, scenario.half_angle,
+        scenario.alpha_max, scenario.lambda_star, scenario.k_v, scenario.k_omega, scenario.dt, PLAN_STEPS,
+    )  # fmt: skip
+
+
+def test_a_straight_pass_flown_by_the_law_has_fig_7s_profile():
+    """Amplitude 0: the profile of the law's own pass is the analytic straight pass of eq. 2 (Fig. 7)
+    to the time step, and so are its two-pass spacing and its reach."""
+    offsets, coverage, forward = profile(PAPER, 0.0)
+    analytic = np.array(
+        [straight_pass_coverage(abs(d), PAPER.range, PAPER.half_angle, PAPER.alpha_max) for d in offsets]
+    )
+    assert forward == pytest.approx(PAPER.k_v, rel=1e-3)
+    assert np.max(np.abs(coverage - analytic / PAPER.lambda_star)) < 0.02 * coverage.max()
+    assert two_pass_spacing(offsets, coverage) == pytest.approx(best_lane_spacing(PAPER), abs=0.1)
+    assert one_pass_reach(offsets, coverage) == pytest.approx(pass_reach(PAPER), abs=0.1)
+
+
+def test_a_weave_spreads_the_pass_wider_and_thinner():
+    """The weave takes ability from the course (a straight pass brings it 5 Λ*) to its sides: the wider the
+    weave, the less on the course, the wider the two-pass spacing, the slower forward."""
+    amplitudes = (0.0, 0.2, 0.4, 0.5)
+    profiles = [profile(PAPER, amplitude) for amplitude in amplitudes]
+    on_course = [coverage[np.argmin(np.abs(offsets))] for offsets, coverage, _ in profiles]
+    spacings = [two_pass_spacing(offsets, coverage) for offsets, coverage, _ in profiles]
+    forwards = [forward for _, _, forward in profiles]
+    assert on_course == sorted(on_course, reverse=True) and on_course[0] > 4.0 > 1.0 < on_course[-1]
+    assert spacings == sorted(spacings) and spacings[-1] > 1.8 * spacings[0]
+    assert forwards == sorted(forwards, reverse=True) and forwards[-1] > 0.8 * PAPER.k_v
+
+
+def test_the_papers_sensor_weaves_and_the_strips_flies_straight():
+    """sweep_of: on the paper's sensor a weave sweeps far more area per time unit than straight lanes
+    (margin included) and reaches farther alone; on the strip's (R = 10) no weave reaches as far alone as
+    a straight pass, so its passes stay straight, exactly as before the weave; ``weave = false`` too."""
+    paper = sweep_of(PAPER)
+    assert paper.amplitude > 0.0 and paper.rate > 1.4 * best_lane_spacing(PAPER) * PAPER.k_v
+    offsets, coverage, forward = profile(PAPER, paper.amplitude)
+    assert paper.spacing == pytest.approx(MARGIN * two_pass_spacing(offsets, coverage))
+    assert paper.reach == pytest.approx(MARGIN * one_pass_reach(offsets, coverage))
+    assert paper.reach > pass_reach(PAPER) and paper.edge == pytest.approx(paper.reach / (2.0 * MARGIN))
+    assert paper.rate == pytest.approx(paper.spacing * forward) and paper.centre_leads == WEAVE_CENTRE_LEADS
+    for straight in (sweep_of(WIDE), sweep_of(PAPER.with_overrides(weave=False))):
+        scenario = WIDE if straight is sweep_of(WIDE) else PAPER
+        assert straight.amplitude == 0.0
+        assert (straight.spacing, straight.reach, straight.edge) == (
+            best_lane_spacing(scenario), pass_reach(scenario), pass_reach(scenario)
+        )
+    with pytest.raises(ScenarioError, match="'weave': expected true or false"):
+        PAPER.with_overrides(weave="yes")
+    assert weave.LOOKAHEAD == lane_planner.LOOKAHEAD  # the profile's carrots are the planner's
+
+
+def test_two_weaving_passes_at_the_sweeps_spacing_cover_everything_between_them_on_the_grid():
+    """What the profile foretells holds where the engine flies (simulate_routes: the law, eq. 1, the grid's
+    fixed-point coverage): two weaving passes the sweep's spacing apart bring every cell between them, away
+    from their ends, to Λ*; one pass brings the cells within its reach."""
+    scenario = PAPER.with_overrides(domain=[120.0, 60.0])
+    sweep = sweep_of(scenario)
+    low, high = 30.0 - sweep.spacing / 2.0, 30.0 + sweep.spacing / 2.0
+    routes = [np.array([[0.0, low], [120.0, low]]), np.array([[0.0, high], [120.0, high]])]
+    lack, _, times = simulate_routes(scenario, routes, np.array([route[0] for route in routes]), lane_planner.LOOKAHEAD)
+    rows = np.arange(scenario.grid_shape[0]) + 0.5
+    between = (rows > low) & (rows < high)
+    assert (lack[between, 40:80] == 0.0).all()
+    assert times[0] == pytest.approx(120.0 / (sweep.rate / sweep.spacing), rel=0.03)
+    alone, _, _ = simulate_routes(scenario, routes[:1], routes[0][:1], lane_planner.LOOKAHEAD)
+    within = np.abs(rows - low) < sweep.reach
+    assert (alone[within, 40:80] == 0.0).all()
