@@ -82,7 +82,9 @@ def test_the_pursuit_law_without_a_weave_is_pure_pursuit(x, y, theta, goal_x, go
     """Amplitude 0: v = k_v min(1, d/(k_v dt)) (1 - 2|e_θ|/π) (held at -k_v), ω = k_ω e_θ, as the straight
     passes of the tables before the weave were flown."""
     v, omega = pursuit_law(x, y, theta, goal_x, goal_y, 1.0, 1.0, 0.1)
-    e_theta = math.atan2(math.sin(math.atan2(goal_y - y, goal_x - x) - theta), math.cos(math.atan2(goal_y - y, goal_x - x) - theta))
+    e_theta = math.atan2(
+        math.sin(math.atan2(goal_y - y, goal_x - x) - theta), math.cos(math.atan2(goal_y - y, goal_x - x) - theta)
+    )
     arrive = min(1.0, math.hypot(goal_x - x, goal_y - y) / 0.1)
     assert v == pytest.approx(arrive * max(-1.0, 1.0 - 2.0 * abs(e_theta) / math.pi), abs=1e-9)
     assert omega == pytest.approx(e_theta, abs=1e-9)

@@ -69,7 +69,9 @@ def test_the_papers_sensor_weaves_and_the_strips_flies_straight():
         scenario = WIDE if straight is sweep_of(WIDE) else PAPER
         assert straight.amplitude == 0.0
         assert (straight.spacing, straight.reach, straight.edge) == (
-            best_lane_spacing(scenario), pass_reach(scenario), pass_reach(scenario)
+            best_lane_spacing(scenario),
+            pass_reach(scenario),
+            pass_reach(scenario),
         )
     with pytest.raises(ScenarioError, match="'weave': expected true or false"):
         PAPER.with_overrides(weave="yes")
