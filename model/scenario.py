@@ -176,6 +176,12 @@ def _number(key: str, value: Any) -> float:
     return float(value)
 
 
+def _boolean(key: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise ScenarioError(f"scenario key '{key}': expected true or false, got {value!r}")
+    return value
+
+
 def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
     """Build a Scenario from a mapping, checking every key; raise ScenarioError naming the bad one.
     Files the scenario names (``map``, a priority map) are relative to ``base`` (the scenario's folder)."""
@@ -223,9 +229,7 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
                 )
             resolved[key] = BEST_CONTROLLER if value == "best" else value
         elif key == "weave":
-            if not isinstance(value, bool):
-                raise ScenarioError(f"scenario key 'weave': expected true or false, got {value!r}")
-            resolved[key] = value
+            resolved[key] = _boolean(key, value)
         elif key == "half_angle_deg":
             angle = _number(key, value)
             if not 0.0 < angle < 180.0:

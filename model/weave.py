@@ -141,7 +141,7 @@ def pass_profile(
     at points across the course, over one wavelength far enough along that the start is behind them."""
     start = sensing_range + 4.0 * wavelength  # the weave has settled, the run-up is behind
     course = start + wavelength + sensing_range + LOOKAHEAD + 1.0
-    xs, ys, thetas = _flown(amplitude, wavelength, k_v, k_omega, dt, plan_steps, course)
+    xs, ys, thetas = flown_course(amplitude, wavelength, k_v, k_omega, dt, plan_steps, course)
     across = 2.0 * sensing_range * math.sin(half_angle) + 2.0  # two passes reach no farther apart
     offsets = np.arange(-across, across + 1e-9, OFFSET_STEP)
     along = start + wavelength * np.arange(PHASES) / PHASES
@@ -153,7 +153,7 @@ def pass_profile(
     return offsets, profile, forward
 
 
-def _flown(
+def flown_course(
     amplitude: float, wavelength: float, k_v: float, k_omega: float, dt: float, plan_steps: int, course: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The poses, one per step, of a robot flying the x axis from the origin to ``course``."""

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from anicov.engine import run_scenario
 from model.control import pursuit_law
+from model.geometry import wrap_angle
 from model.lane_planner import LOOKAHEAD, LanePlanner, blob_passes
 from model.scenario import Scenario, ScenarioError, load_scenario
 
@@ -79,15 +80,13 @@ def test_the_pursuit_law_keeps_the_papers_velocity_bounds(x, y, theta, goal_x, g
 @settings(max_examples=200)
 @given(st.floats(-50, 50), st.floats(-50, 50), st.floats(-math.pi, math.pi), st.floats(-50, 50), st.floats(-50, 50))
 def test_the_pursuit_law_without_a_weave_is_pure_pursuit(x, y, theta, goal_x, goal_y):
-    """Amplitude 0: v = k_v min(1, d/(k_v dt)) (1 - 2|e_θ|/π) (held at -k_v), ω = k_ω e_θ, as the straight
-    passes of the tables before the weave were flown."""
+    """Amplitude 0: v = k_v min(1, d/(k_v dt)) (1 - 2|e_θ|/π) (held at -k_v), ω = k_ω e_θ, bit for bit as
+    the straight passes were flown before the weave (the strip's tables and ``weave = false`` rely on it)."""
     v, omega = pursuit_law(x, y, theta, goal_x, goal_y, 1.0, 1.0, 0.1)
-    e_theta = math.atan2(
-        math.sin(math.atan2(goal_y - y, goal_x - x) - theta), math.cos(math.atan2(goal_y - y, goal_x - x) - theta)
-    )
-    arrive = min(1.0, math.hypot(goal_x - x, goal_y - y) / 0.1)
-    assert v == pytest.approx(arrive * max(-1.0, 1.0 - 2.0 * abs(e_theta) / math.pi), abs=1e-9)
-    assert omega == pytest.approx(e_theta, abs=1e-9)
+    e_theta = wrap_angle(math.atan2(goal_y - y, goal_x - x) - theta)
+    arrive = min(1.0, math.sqrt((goal_x - x) ** 2 + (goal_y - y) ** 2) / (1.0 * 0.1))
+    assert v == 1.0 * arrive * max(-1.0, 1.0 - (2.0 / math.pi) * abs(e_theta))  # bit for bit: the same sums
+    assert omega == e_theta
 
 
 def test_best_names_the_anicov_controller_which_knows_no_walls_and_plans_centrally():
