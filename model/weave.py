@@ -28,21 +28,23 @@ from numba import njit
 from model.control import pursuit_law
 from model.dynamics import unicycle_step
 from model.metrics import pass_reach
-from model.routes import CENTRE_ALLOWANCE_LEADS, best_lane_spacing
+from model.routes import CENTRE_ALLOWANCE_LEADS, Route, best_lane_spacing, spiral_in
 from model.scenario import CARROT_PERIOD, Scenario
 from model.sensing import offset_from_heading, sensing_ability, wedge_reach
 
-AMPLITUDES = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6)
-"""Weave amplitudes tried (radians), besides straight passes. Past 0.5 on the paper's sensor one pass no
+AMPLITUDES = (0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6)
+"""Weave amplitudes tried (radians), besides straight passes. From 0.6 on the paper's sensor one pass no
 longer brings its own course to Λ*."""
 WAVELENGTH_PER_RANGE = 0.175
 """The weave's wavelength as a share of R (3.5 units on the paper's sensor): measured on the paper's
 square, 2.5 - 5 units sweep within 3 % of each other; much longer ones leave gaps at some phases."""
-MARGIN = 0.9
+MARGIN = 0.85
 """Weaving rings lie at most this share of the profile's limits apart (and from the centre): a weave's
-coverage varies with its phase and round a ring's corners, and rings at the limit left cells a few per
-cent short there, each an orbit's trip (the paper's square, 8 seeds: N = 10 2.78 t* at the limit of
-14.6, 2.32 at 0.9 of it)."""
+coverage varies with its phase and round a ring's corners, and rings near the limit left cells a few per
+cent short there, each an orbit's trip. The paper's square, 16 seeds, N = 1 / 4 / 10 / 30: A = 0.4 with
+its four rings 11.2 apart, 0.9 of its limit of 12.5, 2.056 / 2.256 / 2.351 / 2.733 t*; A = 0.45, the same
+rings at 0.83 of its 13.55, 1.932 / 2.044 / 2.234 / 2.694; A = 0.5 at 0.76 of 14.6, 1.945 / 2.062 / 2.299 /
+2.766; three rings 13.7 apart at 0.94 of A = 0.5's limit (8 seeds): 2.31 / 2.45 / 2.73 / 2.81."""
 LOOKAHEAD = 2.0
 """The carrot's distance ahead on the course (:data:`model.lane_planner.LOOKAHEAD`; a test holds them
 equal)."""
@@ -63,35 +65,44 @@ class Sweep:
     """How the anicov controller's robots sweep: the weave (amplitude 0: straight) and what the planner
     draws for it: rings at most ``spacing`` apart, the innermost within ``reach`` of the domain's centre
     line, the outer ring ``edge`` inside the domain's edges, the centre's allowance ``centre_leads``
-    run-ups. ``rate``: area brought to Λ* per time unit."""
+    run-ups; ``forward``: the robot's speed along its course."""
 
     amplitude: float
     wavelength: float
     spacing: float
     reach: float
     edge: float
-    rate: float
+    forward: float
     centre_leads: float = CENTRE_ALLOWANCE_LEADS
+
+    @property
+    def rate(self) -> float:
+        """Area brought to Λ* per time unit by passes ``spacing`` apart."""
+        return self.spacing * self.forward
 
 
 def sweep_of(scenario: Scenario) -> Sweep:
-    """The sweep that covers most area per time unit on ``scenario``'s sensor and robot: straight passes at
-    :func:`model.routes.best_lane_spacing`, reaching d100 (eq. 2, the outer ring d100 inside the edges), or
-    of :data:`AMPLITUDES` the weave whose :data:`MARGIN` of its two-pass spacing times its forward speed is
-    largest, among those whose one pass reaches at least d100 (the outer ring and the centre rely on one
-    pass). A weave's outer ring lies half its reach inside the edges, so that a corner of the domain is
-    within reach of the ring's corner. A scenario with ``weave = false`` sweeps straight."""
+    """The sweep whose spiral (:func:`model.routes.spiral_in`) flies ``scenario``'s domain soonest: straight
+    passes at :func:`model.routes.best_lane_spacing`, reaching d100 (eq. 2; the outer ring d100 inside the
+    edges), or a weave of :data:`AMPLITUDES` at :data:`MARGIN` of its two-pass spacing and of its reach,
+    among those whose one pass reaches at least d100 (the outer ring and the centre rely on one pass), its
+    outer ring half its reach inside the edges (a corner of the domain is then within reach of the ring's
+    corner). The spiral's time is its length over the sweep's forward speed: on a square the rings come in
+    whole numbers, and of weaves that fit the same rings the narrower, faster one is sooner (the paper's
+    square: four rings for A = 0.45 and 0.5, 1,031 and 1,033 units at 0.900 and 0.878 k_v). A scenario with
+    ``weave = false`` sweeps straight."""
     if not scenario.weave:
         return _straight(best_lane_spacing(scenario), pass_reach(scenario), scenario.k_v)
     return _sweep_of(
-        scenario.range, scenario.half_angle, scenario.alpha_max, scenario.lambda_star, scenario.k_v,
-        scenario.k_omega, scenario.dt, max(1, round(CARROT_PERIOD / scenario.dt)), best_lane_spacing(scenario),
-        pass_reach(scenario),
+        tuple(scenario.domain), scenario.range, scenario.half_angle, scenario.alpha_max, scenario.lambda_star,
+        scenario.k_v, scenario.k_omega, scenario.dt, max(1, round(CARROT_PERIOD / scenario.dt)),
+        best_lane_spacing(scenario), pass_reach(scenario),
     )  # fmt: skip
 
 
 @functools.lru_cache(maxsize=16)
 def _sweep_of(
+    domain: tuple[float, float],
     sensing_range: float,
     half_angle: float,
     alpha_max: float,
@@ -105,21 +116,30 @@ def _sweep_of(
 ) -> Sweep:
     wavelength = WAVELENGTH_PER_RANGE * sensing_range
     best = _straight(straight_spacing, straight_reach, k_v)
+    soonest = _spiral_time(domain, best)
     for amplitude in AMPLITUDES:
         offsets, profile, forward = pass_profile(
             amplitude, wavelength, sensing_range, half_angle, alpha_max, lambda_star, k_v, k_omega, dt, plan_steps
         )
-        reach, spacing = one_pass_reach(offsets, profile), MARGIN * two_pass_spacing(offsets, profile)
-        if reach >= straight_reach and spacing * forward > best.rate:
-            best = Sweep(
-                amplitude, wavelength, spacing, MARGIN * reach, reach / 2.0, spacing * forward, WEAVE_CENTRE_LEADS
-            )
+        reach = one_pass_reach(offsets, profile)
+        weave = Sweep(
+            amplitude, wavelength, MARGIN * two_pass_spacing(offsets, profile), MARGIN * reach, reach / 2.0,
+            forward, WEAVE_CENTRE_LEADS,
+        )  # fmt: skip
+        if reach >= straight_reach and _spiral_time(domain, weave) < soonest:
+            best, soonest = weave, _spiral_time(domain, weave)
     return best
+
+
+def _spiral_time(domain: tuple[float, float], sweep: Sweep) -> float:
+    """How long the sweep's one-robot spiral of ``domain`` takes at its forward speed."""
+    whole = Route.of(spiral_in(domain[0], domain[1], sweep.reach, sweep.spacing, sweep.edge))
+    return whole.length / sweep.forward
 
 
 def _straight(spacing: float, reach: float, k_v: float) -> Sweep:
     """Straight passes (no weave) at ``spacing``, reaching ``reach``, the outer ring that far inside."""
-    return Sweep(0.0, 1.0, spacing, reach, reach, spacing * k_v)
+    return Sweep(0.0, 1.0, spacing, reach, reach, k_v)
 
 
 def pass_profile(

@@ -9,7 +9,7 @@ import pytest
 
 from model import lane_planner, weave
 from model.metrics import pass_reach, straight_pass_coverage
-from model.routes import best_lane_spacing
+from model.routes import CENTRE_ALLOWANCE_LEADS, Route, best_lane_spacing, spiral_in
 from model.scenario import CARROT_PERIOD, Scenario, ScenarioError, load_scenario
 from model.touch_ups import simulate_routes
 from model.weave import MARGIN, WEAVE_CENTRE_LEADS, one_pass_reach, pass_profile, sweep_of, two_pass_spacing
@@ -54,21 +54,34 @@ def test_a_weave_spreads_the_pass_wider_and_thinner():
     assert forwards == sorted(forwards, reverse=True) and forwards[-1] > 0.8 * PAPER.k_v
 
 
-def test_the_papers_sensor_weaves_and_the_strips_flies_straight():
-    """sweep_of: on the paper's sensor a weave sweeps far more area per time unit than straight lanes
-    (margin included) and reaches farther alone; on the strip's (R = 10) no weave reaches as far alone as
-    a straight pass, so its passes stay straight, exactly as before the weave; ``weave = false`` too."""
+def test_the_papers_square_weaves_the_spiral_that_flies_soonest_and_the_strip_flies_straight():
+    """sweep_of: of straight passes and every weave that reaches as far alone as a straight pass, the one
+    whose spiral flies the domain soonest (length over forward speed); on the paper's square a weave, far
+    sooner than straight lanes. On the strip's sensor (R = 10) no weave reaches as far alone as a straight
+    pass, so its passes stay straight, exactly as before the weave; ``weave = false`` too."""
     paper = sweep_of(PAPER)
-    assert paper.amplitude > 0.0 and paper.rate > 1.4 * best_lane_spacing(PAPER) * PAPER.k_v
+    assert paper.amplitude > 0.0
     offsets, coverage, forward = profile(PAPER, paper.amplitude)
     assert paper.spacing == pytest.approx(MARGIN * two_pass_spacing(offsets, coverage))
     assert paper.reach == pytest.approx(MARGIN * one_pass_reach(offsets, coverage))
     assert paper.reach > pass_reach(PAPER) and paper.edge == pytest.approx(paper.reach / (2.0 * MARGIN))
-    assert paper.rate == pytest.approx(paper.spacing * forward) and paper.centre_leads == WEAVE_CENTRE_LEADS
-    for straight in (sweep_of(WIDE), sweep_of(PAPER.with_overrides(weave=False))):
-        scenario = WIDE if straight is sweep_of(WIDE) else PAPER
-        assert straight.amplitude == 0.0
-        assert (straight.spacing, straight.reach, straight.edge) == (
+    assert paper.forward == pytest.approx(forward) and paper.centre_leads == WEAVE_CENTRE_LEADS
+
+    def spiral_time(spacing: float, reach: float, edge: float, speed: float) -> float:
+        return Route.of(spiral_in(*PAPER.domain, reach, spacing, edge)).length / speed
+
+    chosen = spiral_time(paper.spacing, paper.reach, paper.edge, paper.forward)
+    straight = spiral_time(best_lane_spacing(PAPER), pass_reach(PAPER), pass_reach(PAPER), PAPER.k_v)
+    assert chosen < 0.85 * straight
+    for amplitude in weave.AMPLITUDES:
+        offsets, coverage, forward = profile(PAPER, amplitude)
+        reach, spacing = one_pass_reach(offsets, coverage), two_pass_spacing(offsets, coverage)
+        if reach >= pass_reach(PAPER):
+            assert chosen <= spiral_time(MARGIN * spacing, MARGIN * reach, reach / 2.0, forward) + 1e-9
+    for scenario in (WIDE, PAPER.with_overrides(weave=False)):
+        straight_sweep = sweep_of(scenario)
+        assert straight_sweep.amplitude == 0.0 and straight_sweep.centre_leads == CENTRE_ALLOWANCE_LEADS
+        assert (straight_sweep.spacing, straight_sweep.reach, straight_sweep.edge) == (
             best_lane_spacing(scenario),
             pass_reach(scenario),
             pass_reach(scenario),
@@ -90,7 +103,7 @@ def test_two_weaving_passes_at_the_sweeps_spacing_cover_everything_between_them_
     rows = np.arange(scenario.grid_shape[0]) + 0.5
     between = (rows > low) & (rows < high)
     assert (lack[between, 40:80] == 0.0).all()
-    assert times[0] == pytest.approx(120.0 / (sweep.rate / sweep.spacing), rel=0.03)
+    assert times[0] == pytest.approx(120.0 / sweep.forward, rel=0.03)
     alone, _, _ = simulate_routes(scenario, routes[:1], routes[0][:1], lane_planner.LOOKAHEAD)
     within = np.abs(rows - low) < sweep.reach
     assert (alone[within, 40:80] == 0.0).all()
