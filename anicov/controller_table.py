@@ -66,6 +66,6 @@ def controller_table(out_dir: Path, challenger: str = "anicov") -> str:
             over = ratio[challenger] - goal
             cells.append("met" if over <= 0 else f"over by {over:.2f}")
             over_path = path[challenger] - PATH_GOAL
-            cells.append("met" if over_path <= 0 else f"over by {100 * over_path:.0f} points")
+            cells.append("met" if over_path <= 0 else f"over by {100 * over_path:.1f} points")
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"

@@ -5,15 +5,15 @@ camera senses onto the line it flies: on the paper's sensor a point on that line
 half a spacing aside just Λ*/2, and lanes at the best spacing (:func:`model.routes.best_lane_spacing`,
 7.73) sweep 7.73 area per time unit, 49 % of what the sensor could. A robot whose heading *weaves* about
 its course, ±A in a sine of wavelength λ along the course, swings its wedge over the points beside it and
-spreads the same ability over a wider band: at A = 0.5 rad two such passes bring Λ* to the point midway
-between them 14.6 apart, at 0.876 of k_v forward, 12.8 area per time unit. The weave lives in the robot's
+spreads the same ability over a wider band: at A = 0.45 rad two such passes bring Λ* to the point midway
+between them 13.6 apart, at 0.90 of k_v forward, 12.2 area per time unit. The weave lives in the robot's
 law (:func:`model.control.pursuit_law`: the messages stay the paper's, one carrot per robot); this module
 flies one such pass as the engine would (the law, the unicycle of eq. 1, carrots every plan period) and
 reads its coverage profile across the course (eq. 2-3, at the least-covered phase of the weave), from
 which the planner takes its rings' spacing, how close to the centre the innermost must come, and where the
-outer ring lies (:func:`sweep_of`). The amplitude is chosen per scenario from :data:`AMPLITUDES`, straight
-(0) included: on the 200 x 50 strip's sensor (R = 10) no weave reaches as far alone as a straight pass
-does, and its passes stay straight.
+outer ring lies, and which amplitude of :data:`AMPLITUDES`, straight (0) included, flies the domain's
+spiral soonest (:func:`sweep_of`; A = 0.45 on the paper's square). On the 200 x 50 strip's sensor (R = 10)
+no weave reaches as far alone as a straight pass does, and its passes stay straight.
 """
 
 from __future__ import annotations
@@ -51,8 +51,8 @@ equal)."""
 WEAVE_CENTRE_LEADS = 2.0
 """The centre's allowance for weaving rings, in run-ups (:func:`model.routes.balanced_routes_on`; straight
 passes count :data:`model.routes.CENTRE_ALLOWANCE_LEADS`, 8): a weave's innermost ring, 2 x its reach
-across, leaves less of the centre, and its run-up is longer (12.9 on the paper's square, against 7.6).
-Measured (16 seeds, N = 4 / 10 / 30): 1, 2, 3, 4, 4.7 and 8 run-ups give 2.070 / 2.286 / 2.751, 2.062 /
+across, leaves less of the centre, and its run-up is longer (11.3 on the paper's square, against 7.6).
+Measured with A = 0.5 (16 seeds, N = 4 / 10 / 30): 1, 2, 3, 4, 4.7 and 8 run-ups give 2.070 / 2.286 / 2.751, 2.062 /
 2.299 / 2.766, 2.069 / 2.313 / 2.784, 2.096 / 2.317 / 2.824, 2.115 / 2.325 / 2.807 and 2.174 / 2.392 / 2.887 t*."""
 PHASES = 12
 """Points sampled along one wavelength of the course, for the least-covered phase."""

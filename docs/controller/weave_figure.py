@@ -22,7 +22,7 @@ sys.path.insert(0, str(ROOT))
 from model.scenario import CARROT_PERIOD, Scenario  # noqa: E402
 from model.weave import WAVELENGTH_PER_RANGE, flown_course, pass_profile, sweep_of, two_pass_spacing  # noqa: E402
 
-AMPLITUDES = (0.0, 0.3, 0.5)
+AMPLITUDES = (0.0, 0.3, 0.45)
 WEDGE_DRAWN = 3.0
 """How much of the wedge's R = 20 is drawn, to keep the drawing readable."""
 
