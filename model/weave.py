@@ -81,6 +81,7 @@ class Sweep:
         return self.spacing * self.forward
 
 
+@functools.lru_cache(maxsize=64)
 def sweep_of(scenario: Scenario) -> Sweep:
     """The sweep whose spiral (:func:`model.routes.spiral_in`) flies ``scenario``'s domain soonest: straight
     passes at :func:`model.routes.best_lane_spacing`, reaching d100 (eq. 2; the outer ring d100 inside the
@@ -90,7 +91,8 @@ def sweep_of(scenario: Scenario) -> Sweep:
     corner). The spiral's time is its length over the sweep's forward speed: on a square the rings come in
     whole numbers, and of weaves that fit the same rings the narrower, faster one is sooner (the paper's
     square: four rings for A = 0.45 and 0.5, 1,031 and 1,033 units at 0.900 and 0.878 k_v). A scenario with
-    ``weave = false`` sweeps straight."""
+    ``weave = false`` sweeps straight. Cached: every flight the planner foresees asks for it (through
+    :func:`model.parameters.law_parameters`), and the straight pass's spacing and reach are integrals."""
     if not scenario.weave:
         return _straight(best_lane_spacing(scenario), pass_reach(scenario), scenario.k_v)
     return _sweep_of(
