@@ -9,7 +9,9 @@ straight pass at full speed wastes least. So:
 1. **A spiral.** A rectangular spiral inward (:func:`model.routes.spiral_path`), its rings evenly
    spaced at most :func:`model.routes.best_lane_spacing` apart (from eq. 2: the widest spacing at
    which two neighbouring passes at k_v still bring the point midway to Λ*), the outer ring d100 inside
-   the edges, the innermost d100 from the centre line. Lanes back and forth need a run-up of about R
+   the edges, the innermost d100 from the centre line; or, where the robots weave their heading and
+   that flies the spiral sooner (:mod:`model.weave`, on the paper's sensor), at the weave's spacing and
+   reach. Lanes back and forth need a run-up of about R
    outside the domain at every lane's start (a forward camera sees a point beside a lane only from
    behind it); a spiral needs one.
 2. **Pieces.** The spiral is cut into N pieces, flown inward (flown outward, a ring's corners leave

@@ -7,7 +7,8 @@ the planner that gives the carrots along these routes):
 - :func:`best_lane_spacing`: from eq. 2, the widest spacing at which two neighbouring passes at k_v still
   bring the point midway to Λ*; :func:`lead_in`: how far before a lane a forward camera must start.
 - :func:`spiral_path`: a rectangular spiral inward, its rings evenly spaced at most that spacing apart,
-  the outer ring d100 inside the edges; :func:`spiral_variants`: the same in the domain's 8 symmetries.
+  the outer ring d100 inside the edges (or a weaving sweep's spacing, reach and edge:
+  :func:`model.weave.sweep_of`); :func:`spiral_variants`: the same in the domain's 8 symmetries.
 - :func:`balanced_routes`: the spiral cut into N pieces flown inward, robots assigned to pieces by the
   least longest transit (:func:`bottleneck_assignment` on scipy's ``linear_sum_assignment``), the pieces
   resized until every robot finishes together, on the symmetry that finishes first; then the order in
@@ -162,11 +163,11 @@ def spiral_path(
     return spiral_in(width, height, reach, spacing, reach if edge is None else edge)
 
 
-def spiral_in(width: float, height: float, d100: float, spacing: float, edge: float | None = None) -> np.ndarray:
-    """:func:`spiral_path` of a ``width`` x ``height`` rectangle whose one pass brings Λ* ``d100`` aside, the
-    outer ring ``edge`` (default ``d100``) inside its edges."""
-    first = min(d100 if edge is None else edge, width / 2.0, height / 2.0)
-    innermost = min(d100, width / 2.0, height / 2.0)
+def spiral_in(width: float, height: float, reach: float, spacing: float, edge: float | None = None) -> np.ndarray:
+    """:func:`spiral_path` of a ``width`` x ``height`` rectangle whose one pass brings Λ* ``reach`` aside (a
+    straight pass's d100), the outer ring ``edge`` (default ``reach``) inside its edges."""
+    first = min(reach if edge is None else edge, width / 2.0, height / 2.0)
+    innermost = min(reach, width / 2.0, height / 2.0)
     inward = min(width, height) / 2.0 - (first + innermost)  # from the outer ring to where the innermost may be
     rings = max(0, math.ceil(inward / spacing - 1e-9))
     step = inward / rings if rings else 0.0
@@ -231,7 +232,10 @@ def balanced_routes(
     starts, the bottleneck transit depends on where the spiral starts and which way it turns (measured, 4
     seeds: N = 4 2.76 -> 2.67 t*, N = 30 3.78 -> 3.58). On the :data:`ORDERED_VARIANTS` that finish
     soonest so (the first on a tie), the order in which robots take pieces is improved and the pieces cut
-    again for it (:func:`ordered_routes`), and the sooner is flown. A robot alone flies the soonest."""
+    again for it (:func:`ordered_routes`), and the sooner is flown. A robot alone flies the soonest.
+    ``reach`` and ``edge`` place the rings (:func:`spiral_path`; default d100), ``centre_leads`` is the
+    centre's allowance in run-ups (:func:`balanced_routes_on`): a weaving sweep's (:func:`model.weave.
+    sweep_of`) differ from a straight pass's."""
     tried = []
     for path in spiral_variants(scenario, spacing, reach, edge):
         routes, finish, owners = balanced_routes_on(scenario, path, positions, lead, centre_leads)
@@ -289,7 +293,8 @@ def balanced_routes_on(
     piece's length halfway to the one that makes transit, run-up and flight the same for all; the routes
     with the earliest estimated finish (longest transit + run-up + piece) are kept (the first on a
     near-tie). The last piece, which ends on the spiral's innermost ring, counts ``centre_leads`` run-ups
-    more (:data:`CENTRE_ALLOWANCE_LEADS` for straight passes; :data:`model.weave.WEAVE_CENTRE_LEADS`): on a square that ring's sides are shorter than a run-up and
+    more (:data:`CENTRE_ALLOWANCE_LEADS` for straight passes; a weave's,
+    :data:`model.weave.WEAVE_CENTRE_LEADS`): on a square that ring's sides are shorter than a run-up and
     it leaves part of the centre to passes (on the paper's square at N = 1: three, 70 time units), which its
     robot, near them, takes while the others finish (4 seeds, with the 8 symmetries: N = 2 2.56 -> 2.47 t*,
     N = 4 2.67 -> 2.63, N = 10 3.11 -> 2.86; without it the team waited for one robot's passes at the

@@ -177,6 +177,7 @@ def _number(key: str, value: Any) -> float:
 
 
 def _boolean(key: str, value: Any) -> bool:
+    """A boolean key's value (TOML true or false), or a ScenarioError naming the key."""
     if not isinstance(value, bool):
         raise ScenarioError(f"scenario key '{key}': expected true or false, got {value!r}")
     return value

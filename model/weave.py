@@ -41,10 +41,11 @@ square, 2.5 - 5 units sweep within 3 % of each other; much longer ones leave gap
 MARGIN = 0.85
 """Weaving rings lie at most this share of the profile's limits apart (and from the centre): a weave's
 coverage varies with its phase and round a ring's corners, and rings near the limit left cells a few per
-cent short there, each an orbit's trip. The paper's square, 16 seeds, N = 1 / 4 / 10 / 30: A = 0.4 with
-its four rings 11.2 apart, 0.9 of its limit of 12.5, 2.056 / 2.256 / 2.351 / 2.733 t*; A = 0.45, the same
-rings at 0.83 of its 13.55, 1.932 / 2.044 / 2.234 / 2.694; A = 0.5 at 0.76 of 14.6, 1.945 / 2.062 / 2.299 /
-2.766; three rings 13.7 apart at 0.94 of A = 0.5's limit (8 seeds): 2.31 / 2.45 / 2.73 / 2.81."""
+cent short there, each an orbit's trip. The paper's square, 16 seeds, N = 1 / 4 / 10 / 30, the margin at
+0.9: A = 0.4 with its rings 11.2 apart, 0.9 of its limit of 12.5, 2.056 / 2.256 / 2.351 / 2.733 t*; A = 0.45,
+rings 11.1 apart at 0.82 of its 13.55, 1.932 / 2.044 / 2.234 / 2.694; A = 0.5 at 0.76 of 14.6, 1.945 / 2.062 /
+2.299 / 2.766; as kept (A = 0.45, the margin at 0.85, rings 11.2 apart) 1.917 / 2.053 / 2.236 / 2.696;
+three rings 13.7 apart at 0.94 of A = 0.5's limit (8 seeds): 2.31 / 2.45 / 2.73 / 2.81."""
 LOOKAHEAD = 2.0
 """The carrot's distance ahead on the course (:data:`model.lane_planner.LOOKAHEAD`; a test holds them
 equal)."""
@@ -54,6 +55,8 @@ passes count :data:`model.routes.CENTRE_ALLOWANCE_LEADS`, 8): a weave's innermos
 across, leaves less of the centre, and its run-up is longer (11.3 on the paper's square, against 7.6).
 Measured with A = 0.5 (16 seeds, N = 4 / 10 / 30): 1, 2, 3, 4, 4.7 and 8 run-ups give 2.070 / 2.286 / 2.751, 2.062 /
 2.299 / 2.766, 2.069 / 2.313 / 2.784, 2.096 / 2.317 / 2.824, 2.115 / 2.325 / 2.807 and 2.174 / 2.392 / 2.887 t*."""
+COURSE_STEPS_PER_UNIT = 1000
+"""A cap on the steps of a simulated pass (at k_v = 1 and dt = 0.1 it takes about 10 a unit)."""
 PHASES = 12
 """Points sampled along one wavelength of the course, for the least-covered phase."""
 OFFSET_STEP = 0.05
@@ -86,11 +89,14 @@ def sweep_of(scenario: Scenario) -> Sweep:
     """The sweep whose spiral (:func:`model.routes.spiral_in`) flies ``scenario``'s domain soonest: straight
     passes at :func:`model.routes.best_lane_spacing`, reaching d100 (eq. 2; the outer ring d100 inside the
     edges), or a weave of :data:`AMPLITUDES` at :data:`MARGIN` of its two-pass spacing and of its reach,
-    among those whose one pass reaches at least d100 (the outer ring and the centre rely on one pass), its
+    among those whose one pass reaches at least as far as the law's straight pass (d100, the outer ring and
+    the centre rely on one pass; both as flown here, :func:`pass_profile`), its
     outer ring half its reach inside the edges (a corner of the domain is then within reach of the ring's
     corner). The spiral's time is its length over the sweep's forward speed: on a square the rings come in
     whole numbers, and of weaves that fit the same rings the narrower, faster one is sooner (the paper's
-    square: four rings for A = 0.45 and 0.5, 1,031 and 1,033 units at 0.900 and 0.878 k_v). A scenario with
+    square: A = 0.45 and 0.5 both give rings 11.2 apart, spirals of 1,027 and 1,029 units at 0.900 and
+    0.878 k_v). The processes that plan and those that fly each compute it from the scenario they agreed on
+    (:mod:`protocol.agreement`); it is deterministic, the same numba kernels on the same inputs. A scenario with
     ``weave = false`` sweeps straight. Cached: every flight the planner foresees asks for it (through
     :func:`model.parameters.law_parameters`), and the straight pass's spacing and reach are integrals."""
     if not scenario.weave:
@@ -116,19 +122,25 @@ def _sweep_of(
     straight_spacing: float,
     straight_reach: float,
 ) -> Sweep:
+    """:func:`sweep_of` of a sensor and robot (cached: every weave's pass is flown once per sensor)."""
     wavelength = WAVELENGTH_PER_RANGE * sensing_range
-    best = _straight(straight_spacing, straight_reach, k_v)
-    soonest = _spiral_time(domain, best)
-    for amplitude in AMPLITUDES:
-        offsets, profile, forward = pass_profile(
+
+    def flown(amplitude: float) -> tuple[np.ndarray, np.ndarray, float]:
+        return pass_profile(
             amplitude, wavelength, sensing_range, half_angle, alpha_max, lambda_star, k_v, k_omega, dt, plan_steps
         )
+
+    best = _straight(straight_spacing, straight_reach, k_v)
+    soonest = _spiral_time(domain, best)
+    bar = one_pass_reach(*flown(0.0)[:2])  # d100 as the law flies it (2.69 here for the analytic 2.72)
+    for amplitude in AMPLITUDES:
+        offsets, profile, forward = flown(amplitude)
         reach = one_pass_reach(offsets, profile)
         weave = Sweep(
             amplitude, wavelength, MARGIN * two_pass_spacing(offsets, profile), MARGIN * reach, reach / 2.0,
             forward, WEAVE_CENTRE_LEADS,
         )  # fmt: skip
-        if reach >= straight_reach and _spiral_time(domain, weave) < soonest:
+        if reach >= bar and _spiral_time(domain, weave) < soonest:
             best, soonest = weave, _spiral_time(domain, weave)
     return best
 
@@ -178,11 +190,13 @@ def pass_profile(
 def flown_course(
     amplitude: float, wavelength: float, k_v: float, k_omega: float, dt: float, plan_steps: int, course: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The poses, one per step, of a robot flying the x axis from the origin to ``course``."""
+    """The poses, one per step, of a robot flying the x axis from the origin to ``course`` (at most
+    :data:`COURSE_STEPS_PER_UNIT` steps a unit: a law that does not get there gives a profile that reaches
+    nothing, and its amplitude is not taken)."""
     x = y = theta = progress = 0.0
     poses = []
     step = 0
-    while x < course:
+    while x < course and step < COURSE_STEPS_PER_UNIT * course:
         if step % plan_steps == 0:
             progress = max(progress, min(max(x, 0.0), progress + LOOKAHEAD))
         poses.append((x, y, theta))

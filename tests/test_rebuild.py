@@ -11,7 +11,6 @@ from coordinator.rebuild import by_step, rebuild, resume_step
 from model.coverage_map import CoverageMap
 from model.lane_planner import LanePlanner
 from model.parameters import initial_poses
-from model.routes import best_lane_spacing
 from tests.test_coordinator_node import SCENARIO, team_steps
 
 
@@ -82,4 +81,4 @@ def test_a_realtime_anicov_coordinator_cuts_its_routes_again_and_puts_each_robot
         route = node.planner.routes[agent]
         assert np.array_equal(route.points, fresh.routes[agent].points)
         gap, at = route.nearest(np.array(node.positions[agent]))
-        assert route.done() or (gap <= best_lane_spacing(scenario) / 2.0 and route.progress == at)
+        assert route.done() or (gap <= node.planner.spacing / 2.0 and route.progress == at)

@@ -19,6 +19,7 @@ WIDE = load_scenario(Path(__file__).resolve().parent.parent / "scenarios" / "wid
     controller="anicov"
 )
 PLAN_STEPS = round(CARROT_PERIOD / PAPER.dt)
+LOOKAHEAD_AHEAD = 1.75  # the carrot's mean distance ahead: 2 when given, 1.5 when the next one comes
 
 
 def profile(scenario: Scenario, amplitude: float) -> tuple[np.ndarray, np.ndarray, float]:
@@ -97,6 +98,7 @@ def test_two_weaving_passes_at_the_sweeps_spacing_cover_everything_between_them_
     from their ends, to Λ*; one pass brings the cells within its reach."""
     scenario = PAPER.with_overrides(domain=[120.0, 60.0])
     sweep = sweep_of(scenario)
+    assert sweep.amplitude > 0.0  # a weave (this domain's spiral is soonest weaving too)
     low, high = 30.0 - sweep.spacing / 2.0, 30.0 + sweep.spacing / 2.0
     routes = [np.array([[0.0, low], [120.0, low]]), np.array([[0.0, high], [120.0, high]])]
     lack, _, times = simulate_routes(scenario, routes, np.array([route[0] for route in routes]), lane_planner.LOOKAHEAD)
@@ -107,3 +109,16 @@ def test_two_weaving_passes_at_the_sweeps_spacing_cover_everything_between_them_
     alone, _, _ = simulate_routes(scenario, routes[:1], routes[0][:1], lane_planner.LOOKAHEAD)
     within = np.abs(rows - low) < sweep.reach
     assert (alone[within, 40:80] == 0.0).all()
+
+
+def test_the_law_steers_the_heading_along_the_weave_with_its_rate_fed_forward():
+    """On a straight course, once settled, the heading follows bearing + A sin(2π x/λ) within a fifth of a
+    radian (the feed-forward's sign and units: without it the error is 0.49 rad, with it reversed 0.91),
+    and the heading swings through about ±A."""
+    amplitude, wavelength = 0.45, 3.5
+    xs, ys, thetas = weave.flown_course(amplitude, wavelength, 1.0, 1.0, 0.1, PLAN_STEPS, 60.0)
+    settled = xs > 20.0
+    reference = np.arctan2(-ys, LOOKAHEAD_AHEAD) + amplitude * np.sin(2.0 * np.pi * xs / wavelength)
+    error = np.angle(np.exp(1j * (reference - thetas)))[settled]
+    assert np.abs(error).max() < 0.25
+    assert 0.8 * amplitude < np.abs(thetas[settled]).max() < 1.3 * amplitude

@@ -38,7 +38,7 @@ def main() -> None:
             scenario.k_v, scenario.k_omega, scenario.dt, plan_steps,
         )  # fmt: skip
         spacing = two_pass_spacing(offsets, profile)
-        label = "straight" if amplitude == 0.0 else f"weave ±{amplitude:.1f} rad"
+        label = "straight" if amplitude == 0.0 else f"weave ±{amplitude:.2f} rad"
         across.plot(offsets, profile, label=f"{label}: two passes {spacing:.1f} apart, {forward:.2f} k_v forward")
     across.axhline(1.0, color="k", lw=0.8, ls="--")
     across.set_ylim(0.0, 5.5)
@@ -53,7 +53,7 @@ def main() -> None:
     )
     keep = (xs > 20.0) & (xs < 45.0)
     path.plot(
-        xs[keep], ys[keep], color="C2", lw=1.5, label=f"path, weave ±{sweep.amplitude:.1f} rad, λ = {wavelength:.1f}"
+        xs[keep], ys[keep], color="C2", lw=1.5, label=f"path, weave ±{sweep.amplitude:.2f} rad, λ = {wavelength:.1f}"
     )
     for quarter in range(5):  # the wedge at five phases a quarter wavelength apart, a period and more between
         k = int(np.argmin(np.abs(xs - (21.0 + quarter * 1.25 * wavelength))))
