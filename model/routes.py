@@ -160,7 +160,7 @@ def spiral_path(
     ``edge`` default to d100, a straight pass's (:func:`model.weave.sweep_of` gives a weave's)."""
     width, height = scenario.domain
     reach = pass_reach(scenario) if reach is None else reach
-    return spiral_in(width, height, reach, spacing, reach if edge is None else edge)
+    return spiral_in(width, height, reach, spacing, edge)  # edge None: spiral_in puts the outer ring at the reach
 
 
 def spiral_in(width: float, height: float, reach: float, spacing: float, edge: float | None = None) -> np.ndarray:
@@ -203,7 +203,6 @@ def spiral_variants(
     does (on the innermost ring)."""
     width, height = scenario.domain
     reach = pass_reach(scenario) if reach is None else reach
-    edge = reach if edge is None else edge
     along_x = spiral_in(width, height, reach, spacing, edge)
     along_y = spiral_in(height, width, reach, spacing, edge)[:, ::-1]  # the transposed rectangle's, transposed back
     variants = []

@@ -21,6 +21,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -63,6 +64,29 @@ OFFSET_STEP = 0.05
 """Spacing (units) of the points sampled across the course."""
 
 
+class PassLaw(NamedTuple):
+    """What one pass's flight and coverage depend on: the sensor (eq. 2), Λ*, the law's gains, the time
+    step and the steps between two carrots."""
+
+    sensing_range: float
+    half_angle: float
+    alpha_max: float
+    lambda_star: float
+    k_v: float
+    k_omega: float
+    dt: float
+    plan_steps: int
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> PassLaw:
+        """A scenario's, with the anicov controller's carrot period (:attr:`Scenario.plan_steps` reads the
+        scenario's own controller; the sweep is the anicov controller's whatever the file names)."""
+        return cls(
+            scenario.range, scenario.half_angle, scenario.alpha_max, scenario.lambda_star, scenario.k_v,
+            scenario.k_omega, scenario.dt, max(1, round(CARROT_PERIOD / scenario.dt)),
+        )  # fmt: skip
+
+
 @dataclass(frozen=True)
 class Sweep:
     """How the anicov controller's robots sweep: the weave (amplitude 0: straight) and what the planner
@@ -101,47 +125,28 @@ def sweep_of(scenario: Scenario) -> Sweep:
     :func:`model.parameters.law_parameters`), and the straight pass's spacing and reach are integrals."""
     if not scenario.weave:
         return _straight(best_lane_spacing(scenario), pass_reach(scenario), scenario.k_v)
-    return _sweep_of(
-        tuple(scenario.domain), scenario.range, scenario.half_angle, scenario.alpha_max, scenario.lambda_star,
-        scenario.k_v, scenario.k_omega, scenario.dt, max(1, round(CARROT_PERIOD / scenario.dt)),
-        best_lane_spacing(scenario), pass_reach(scenario),
-    )  # fmt: skip
+    return _sweep_of(tuple(scenario.domain), PassLaw.of(scenario), best_lane_spacing(scenario), pass_reach(scenario))
 
 
 @functools.lru_cache(maxsize=16)
-def _sweep_of(
-    domain: tuple[float, float],
-    sensing_range: float,
-    half_angle: float,
-    alpha_max: float,
-    lambda_star: float,
-    k_v: float,
-    k_omega: float,
-    dt: float,
-    plan_steps: int,
-    straight_spacing: float,
-    straight_reach: float,
-) -> Sweep:
-    """:func:`sweep_of` of a sensor and robot (cached: every weave's pass is flown once per sensor)."""
-    wavelength = WAVELENGTH_PER_RANGE * sensing_range
-
-    def flown(amplitude: float) -> tuple[np.ndarray, np.ndarray, float]:
-        return pass_profile(
-            amplitude, wavelength, sensing_range, half_angle, alpha_max, lambda_star, k_v, k_omega, dt, plan_steps
-        )
-
-    best = _straight(straight_spacing, straight_reach, k_v)
+def _sweep_of(domain: tuple[float, float], law: PassLaw, straight_spacing: float, straight_reach: float) -> Sweep:
+    """:func:`sweep_of` of a domain, sensor and robot (cached: every weave's pass is flown once per sensor)."""
+    wavelength = WAVELENGTH_PER_RANGE * law.sensing_range
+    best = _straight(straight_spacing, straight_reach, law.k_v)
     soonest = _spiral_time(domain, best)
-    bar = one_pass_reach(*flown(0.0)[:2])  # d100 as the law flies it (2.69 here for the analytic 2.72)
+    bar = one_pass_reach(*pass_profile(0.0, wavelength, law)[:2])  # d100 as the law flies it (2.69 for 2.72)
     for amplitude in AMPLITUDES:
-        offsets, profile, forward = flown(amplitude)
+        offsets, profile, forward = pass_profile(amplitude, wavelength, law)
         reach = one_pass_reach(offsets, profile)
+        if reach < bar:
+            continue
         weave = Sweep(
             amplitude, wavelength, MARGIN * two_pass_spacing(offsets, profile), MARGIN * reach, reach / 2.0,
             forward, WEAVE_CENTRE_LEADS,
         )  # fmt: skip
-        if reach >= bar and _spiral_time(domain, weave) < soonest:
-            best, soonest = weave, _spiral_time(domain, weave)
+        time = _spiral_time(domain, weave)
+        if time < soonest:
+            best, soonest = weave, time
     return best
 
 
@@ -156,39 +161,28 @@ def _straight(spacing: float, reach: float, k_v: float) -> Sweep:
     return Sweep(0.0, 1.0, spacing, reach, reach, k_v)
 
 
-def pass_profile(
-    amplitude: float,
-    wavelength: float,
-    sensing_range: float,
-    half_angle: float,
-    alpha_max: float,
-    lambda_star: float,
-    k_v: float,
-    k_omega: float,
-    dt: float,
-    plan_steps: int,
-) -> tuple[np.ndarray, np.ndarray, float]:
+def pass_profile(amplitude: float, wavelength: float, law: PassLaw) -> tuple[np.ndarray, np.ndarray, float]:
     """(offsets across the course, Λ/Λ* there at the least-covered phase, forward speed) of one pass along
     a straight course, flown as the engine flies a route: from the course's start heading along it, a carrot
     :data:`LOOKAHEAD` ahead of the robot's progress every ``plan_steps`` steps, :func:`model.control.
     pursuit_law` with the weave, eq. 1 exactly; the wedge's ability (eq. 2) summed over the steps (eq. 3)
     at points across the course, over one wavelength far enough along that the start is behind them."""
-    start = sensing_range + 4.0 * wavelength  # the weave has settled, the run-up is behind
-    course = start + wavelength + sensing_range + LOOKAHEAD + 1.0
-    xs, ys, thetas = flown_course(amplitude, wavelength, k_v, k_omega, dt, plan_steps, course)
-    across = 2.0 * sensing_range * math.sin(half_angle) + 2.0  # two passes reach no farther apart
+    start = law.sensing_range + 4.0 * wavelength  # the weave has settled, the run-up is behind
+    course = start + wavelength + law.sensing_range + LOOKAHEAD + 1.0
+    xs, ys, thetas = flown_course(amplitude, wavelength, law, course)
+    across = 2.0 * law.sensing_range * math.sin(law.half_angle) + 2.0  # two passes reach no farther apart
     offsets = np.arange(-across, across + 1e-9, OFFSET_STEP)
     along = start + wavelength * np.arange(PHASES) / PHASES
     points_x = np.repeat(along[None, :], len(offsets), axis=0).ravel()
     points_y = np.repeat(offsets[:, None], PHASES, axis=1).ravel()
-    sensed = _coverage(xs, ys, thetas, points_x, points_y, sensing_range, half_angle, alpha_max, dt)
-    profile = sensed.reshape(len(offsets), PHASES).min(axis=1) / lambda_star
-    forward = float((xs[-1] - xs[0]) / (dt * (len(xs) - 1)))
+    sensed = _coverage(xs, ys, thetas, points_x, points_y, law.sensing_range, law.half_angle, law.alpha_max, law.dt)
+    profile = sensed.reshape(len(offsets), PHASES).min(axis=1) / law.lambda_star
+    forward = float((xs[-1] - xs[0]) / (law.dt * (len(xs) - 1)))
     return offsets, profile, forward
 
 
 def flown_course(
-    amplitude: float, wavelength: float, k_v: float, k_omega: float, dt: float, plan_steps: int, course: float
+    amplitude: float, wavelength: float, law: PassLaw, course: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The poses, one per step, of a robot flying the x axis from the origin to ``course`` (at most
     :data:`COURSE_STEPS_PER_UNIT` steps a unit: a law that does not get there gives a profile that reaches
@@ -197,11 +191,13 @@ def flown_course(
     poses = []
     step = 0
     while x < course and step < COURSE_STEPS_PER_UNIT * course:
-        if step % plan_steps == 0:
+        if step % law.plan_steps == 0:
             progress = max(progress, min(max(x, 0.0), progress + LOOKAHEAD))
         poses.append((x, y, theta))
-        v, omega = pursuit_law(x, y, theta, progress + LOOKAHEAD, 0.0, k_v, k_omega, dt, amplitude, wavelength)
-        x, y, theta = unicycle_step(x, y, theta, v, omega, dt)
+        v, omega = pursuit_law(
+            x, y, theta, progress + LOOKAHEAD, 0.0, law.k_v, law.k_omega, law.dt, amplitude, wavelength
+        )
+        x, y, theta = unicycle_step(x, y, theta, v, omega, law.dt)
         step += 1
     flown = np.array(poses)
     return flown[:, 0], flown[:, 1], flown[:, 2]

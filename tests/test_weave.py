@@ -10,23 +10,19 @@ import pytest
 from model import lane_planner, weave
 from model.metrics import pass_reach, straight_pass_coverage
 from model.routes import CENTRE_ALLOWANCE_LEADS, Route, best_lane_spacing, spiral_in
-from model.scenario import CARROT_PERIOD, Scenario, ScenarioError, load_scenario
+from model.scenario import Scenario, ScenarioError, load_scenario
 from model.touch_ups import simulate_routes
-from model.weave import MARGIN, WEAVE_CENTRE_LEADS, one_pass_reach, pass_profile, sweep_of, two_pass_spacing
+from model.weave import MARGIN, WEAVE_CENTRE_LEADS, PassLaw, one_pass_reach, pass_profile, sweep_of, two_pass_spacing
 
 PAPER = Scenario().with_overrides(controller="anicov")
 WIDE = load_scenario(Path(__file__).resolve().parent.parent / "scenarios" / "wide.toml").with_overrides(
     controller="anicov"
 )
-PLAN_STEPS = round(CARROT_PERIOD / PAPER.dt)
 LOOKAHEAD_AHEAD = 1.75  # the carrot's mean distance ahead: 2 when given, 1.5 when the next one comes
 
 
 def profile(scenario: Scenario, amplitude: float) -> tuple[np.ndarray, np.ndarray, float]:
-    return pass_profile(
-        amplitude, weave.WAVELENGTH_PER_RANGE * scenario.range, scenario.range, scenario.half_angle,
-        scenario.alpha_max, scenario.lambda_star, scenario.k_v, scenario.k_omega, scenario.dt, PLAN_STEPS,
-    )  # fmt: skip
+    return pass_profile(amplitude, weave.WAVELENGTH_PER_RANGE * scenario.range, PassLaw.of(scenario))
 
 
 def test_a_straight_pass_flown_by_the_law_has_fig_7s_profile():
@@ -116,7 +112,7 @@ def test_the_law_steers_the_heading_along_the_weave_with_its_rate_fed_forward():
     radian (the feed-forward's sign and units: without it the error is 0.49 rad, with it reversed 0.91),
     and the heading swings through about ±A."""
     amplitude, wavelength = 0.45, 3.5
-    xs, ys, thetas = weave.flown_course(amplitude, wavelength, 1.0, 1.0, 0.1, PLAN_STEPS, 60.0)
+    xs, ys, thetas = weave.flown_course(amplitude, wavelength, PassLaw.of(PAPER), 60.0)
     settled = xs > 20.0
     reference = np.arctan2(-ys, LOOKAHEAD_AHEAD) + amplitude * np.sin(2.0 * np.pi * xs / wavelength)
     error = np.angle(np.exp(1j * (reference - thetas)))[settled]

@@ -19,8 +19,15 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from model.scenario import CARROT_PERIOD, Scenario  # noqa: E402
-from model.weave import WAVELENGTH_PER_RANGE, flown_course, pass_profile, sweep_of, two_pass_spacing  # noqa: E402
+from model.scenario import Scenario  # noqa: E402
+from model.weave import (  # noqa: E402
+    WAVELENGTH_PER_RANGE,
+    PassLaw,
+    flown_course,
+    pass_profile,
+    sweep_of,
+    two_pass_spacing,
+)
 
 AMPLITUDES = (0.0, 0.3, 0.45)
 WEDGE_DRAWN = 3.0
@@ -30,13 +37,10 @@ WEDGE_DRAWN = 3.0
 def main() -> None:
     scenario = Scenario().with_overrides(controller="anicov")
     wavelength = WAVELENGTH_PER_RANGE * scenario.range
-    plan_steps = round(CARROT_PERIOD / scenario.dt)
+    law = PassLaw.of(scenario)
     figure, (across, path) = plt.subplots(1, 2, figsize=(12, 4.5), gridspec_kw={"width_ratios": [1.1, 1]})
     for amplitude in AMPLITUDES:
-        offsets, profile, forward = pass_profile(
-            amplitude, wavelength, scenario.range, scenario.half_angle, scenario.alpha_max, scenario.lambda_star,
-            scenario.k_v, scenario.k_omega, scenario.dt, plan_steps,
-        )  # fmt: skip
+        offsets, profile, forward = pass_profile(amplitude, wavelength, law)
         spacing = two_pass_spacing(offsets, profile)
         label = "straight" if amplitude == 0.0 else f"weave ±{amplitude:.2f} rad"
         across.plot(offsets, profile, label=f"{label}: two passes {spacing:.1f} apart, {forward:.2f} k_v forward")
@@ -48,9 +52,7 @@ def main() -> None:
     across.set_title("One pass of the paper's sensor (R = 20, F = 27°) at k_v")
     across.legend(fontsize=8, loc="upper right")
     sweep = sweep_of(scenario)
-    xs, ys, thetas = flown_course(
-        sweep.amplitude, sweep.wavelength, scenario.k_v, scenario.k_omega, scenario.dt, plan_steps, 60.0
-    )
+    xs, ys, thetas = flown_course(sweep.amplitude, sweep.wavelength, law, 60.0)
     keep = (xs > 20.0) & (xs < 45.0)
     path.plot(
         xs[keep], ys[keep], color="C2", lw=1.5, label=f"path, weave ±{sweep.amplitude:.2f} rad, λ = {wavelength:.1f}"
