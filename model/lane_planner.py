@@ -100,8 +100,12 @@ class LanePlanner:
 
     def __post_init__(self) -> None:
         self.sweep = sweep_of(self.scenario)
-        self.spacing = self.sweep.spacing
         self.lead = lead_in(self.scenario, self.spacing)
+
+    @property
+    def spacing(self) -> float:
+        """The rings' spacing (:attr:`model.weave.Sweep.spacing`)."""
+        return self.sweep.spacing
 
     def plan(self, lack: np.ndarray, positions: np.ndarray, members: list[int] | None = None) -> np.ndarray:
         """A carrot (x, y) for every member (default all, in id order), shape (M, 2)."""
@@ -111,7 +115,7 @@ class LanePlanner:
             start = self._all(ids, positions)
             sweep = self.sweep
             routes = balanced_routes(
-                self.scenario, self.spacing, start, self.lead, sweep.reach, sweep.edge, sweep.centre_leads
+                self.scenario, sweep.spacing, start, self.lead, sweep.reach, sweep.edge, sweep.centre_leads
             )
             routes, touch_ups = with_touch_ups(self.scenario, routes, start, LOOKAHEAD, self.spacing)
             for agent, route in zip(range(self.scenario.agents), routes, strict=True):

@@ -73,6 +73,18 @@ def no_look() -> np.ndarray:
 
 
 @njit(cache=True)
+def pursue(
+    x: float, y: float, theta: float, objective_x: float, objective_y: float, law: LawParameters
+) -> tuple[float, float]:
+    """(v, ω) of the anicov controller's law (:func:`model.control.pursuit_law`) toward ``objective``, with
+    ``law``'s gains, time step and weave."""
+    return pursuit_law(
+        x, y, theta, objective_x, objective_y, law.k_v, law.k_omega, law.dt, law.weave_amplitude,
+        law.weave_wavelength,
+    )  # fmt: skip
+
+
+@njit(cache=True)
 def decide_and_sense(
     coverage: np.ndarray,
     x: float,
@@ -96,10 +108,7 @@ def decide_and_sense(
     teammates = teammates_in_view(ground, positions, me, x, y, law.sensing_range)
     e_omega, w_left, w_right, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, teammates)
     if law.pursuit:
-        v, omega = pursuit_law(
-            x, y, theta, objective_x, objective_y, law.k_v, law.k_omega, law.dt, law.weave_amplitude,
-            law.weave_wavelength,
-        )  # fmt: skip
+        v, omega = pursue(x, y, theta, objective_x, objective_y, law)
         return v, omega, e_omega, row0, col0, ticks
     u_loc, theta_loc = local_law(e_omega, w_left, w_right, theta, law.half_angle)
     u_glo, theta_glo = global_law(x, y, objective_x, objective_y, law.sensing_range, law.literal_heading)

@@ -28,7 +28,6 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from model.control import pursuit_law
 from model.coverage_map import add_window
 from model.dynamics import unicycle_step
 from model.ground import open_ground
@@ -36,6 +35,7 @@ from model.parameters import coverage_map_of, law_parameters
 from model.routes import Route
 from model.scenario import Scenario
 from model.sensing import sense_wedge_among
+from model.step import pursue
 
 ORBIT_RADIUS = 1.5
 """Radius of a touch-up orbit (units). Measured (16 seeds, N = 2, 4, 10, 30 on the paper's square): 1.0
@@ -89,10 +89,7 @@ def simulate_routes(
                 if route.done():
                     break
                 carrot = route.point_at(route.progress + lookahead)
-            v, omega = pursuit_law(
-                x, y, theta, carrot[0], carrot[1], law.k_v, law.k_omega, law.dt, law.weave_amplitude,
-                law.weave_wavelength,
-            )  # fmt: skip
+            v, omega = pursue(x, y, theta, carrot[0], carrot[1], law)
             _, _, _, row0, col0, window = sense_wedge_among(
                 ticks, law.target_ticks, x, y, theta, law.sensing_range, law.half_angle, law.alpha_max,
                 law.dt, law.cell, ground, nobody,
