@@ -83,6 +83,7 @@ def pursuit_law(
     dt: float,
     weave_amplitude: float = 0.0,
     weave_wavelength: float = 1.0,
+    face_radius: float = 0.0,
 ) -> tuple[float, float]:
     """Beyond the paper, the ``anicov`` controller (docs/controller.md): drive at the objective, a carrot
     on the planned path (pure pursuit, Coulter 1992), at full speed until the carrot is within one step,
@@ -95,10 +96,18 @@ def pursuit_law(
     spiral's sides are axis-parallel; a stateless phase, the same in every process), with the reference's
     own rate fed forward, ω = k_ω e_θ + A cos(2π s/λ) (2π/λ) ds/dt, held to |ω| ≤ π k_ω; the speed drops
     only for the part of the bearing error beyond A: v = k_v min(1, d/(k_v dt)) (1 − 2 max(0, |e_b| − A)/π).
-    With A = 0 this is the law above."""
+    With A = 0 this is the law above.
+
+    A carrot nearer than ``face_radius`` (> 0; a robot at a station, :mod:`model.stations`) is a bearing to
+    face, not a place to go: the robot stands (v = 0) and turns toward the carrot's bearing at the bound,
+    ω = e_θ/dt held to |ω| ≤ π k_ω (it reaches the bearing within the step where it can). With
+    ``face_radius`` = 0 (every sweep but the stations) this never applies."""
     dx = objective_x - x
     dy = objective_y - y
     bearing = math.atan2(dy, dx)
+    if dx * dx + dy * dy < face_radius * face_radius:
+        bound = math.pi * k_omega
+        return 0.0, min(bound, max(-bound, wrap_angle(bearing - theta) / dt))
     along_x = abs(dx) >= abs(dy)
     phase = 2.0 * math.pi * (x if along_x else y) / weave_wavelength
     e_theta = wrap_angle(bearing + weave_amplitude * math.sin(phase) - theta)

@@ -45,14 +45,16 @@ drives toward it with :func:`model.control.pursuit_law`. Same interface as
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from model.objectives import BlobObjectives
-from model.routes import Route, balanced_routes, lead_in
+from model.routes import Route, Stop, balanced_routes, lead_in
 from model.scenario import Scenario
+from model.stations import FACE_RADIUS, station_routes
 from model.touch_ups import TouchUp, blob_labels, with_touch_ups
 from model.weave import sweep_of
 
@@ -60,6 +62,10 @@ Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
 
 LOOKAHEAD = 2.0
 """Distance ahead along the path at which the carrot is put (units)."""
+STARE_DISTANCE = 0.25
+"""With stations, how far from a blob's centroid a robot stands to stare at it (a share of R)."""
+STARE_PERIODS = 2
+"""With stations, plan periods a robot stares at a blob before the blobs are dealt out again."""
 
 
 def blob_passes(
@@ -114,12 +120,16 @@ class LanePlanner:
         if not self.routes:
             start = self._all(ids, positions)
             sweep = self.sweep
-            routes = balanced_routes(
-                self.scenario, sweep.spacing, start, self.lead, sweep.reach, sweep.edge, sweep.centre_leads
-            )
-            routes, touch_ups = with_touch_ups(self.scenario, routes, start, LOOKAHEAD, self.spacing)
+            stops: list[list[Stop]] | None = None
+            if self.scenario.stations:
+                routes, stops, _ = station_routes(self.scenario, start)
+            else:
+                routes = balanced_routes(
+                    self.scenario, sweep.spacing, start, self.lead, sweep.reach, sweep.edge, sweep.centre_leads
+                )
+            routes, touch_ups = with_touch_ups(self.scenario, routes, start, LOOKAHEAD, self.spacing, stops)
             for agent, route in zip(range(self.scenario.agents), routes, strict=True):
-                self.routes[agent] = Route.of(route)
+                self.routes[agent] = Route.of(route, stops=None if stops is None else stops[agent])
                 self.touch_ups[agent] = touch_ups[agent]
         window = LOOKAHEAD  # no robot is past the carrot it was given (it slows to stop on it)
         free = []
@@ -131,8 +141,10 @@ class LanePlanner:
                 free.append(index)
         if free:
             self._give_passes(lack, positions, ids, free)
+        face = FACE_RADIUS if self.scenario.stations else 0.0
         targets = np.array(
-            [self.routes[agent].point_at(self.routes[agent].progress + LOOKAHEAD) for agent in ids], dtype=np.float64
+            [self.routes[agent].carrot(positions[index], LOOKAHEAD, face) for index, agent in enumerate(ids)],
+            dtype=np.float64,
         )
         return targets.reshape(-1, 2)
 
@@ -197,8 +209,25 @@ class LanePlanner:
         robots, chosen = linear_sum_assignment(distance.min(axis=2))
         for robot, blob in zip(robots, chosen, strict=True):
             index = free[robot]
+            if self.scenario.stations:
+                self.routes[ids[index]] = self._stare_at(positions[index], centres[blob])
+                continue
             entry, exit_ = ways[blob, int(np.argmin(distance[robot, blob]))]
             self.routes[ids[index]] = Route.of(np.array([positions[index], entry, exit_]), cleanup=True)
+
+    def _stare_at(self, position: np.ndarray, centre: np.ndarray) -> Route:
+        """With stations (:mod:`model.stations`), a robot's turn at a blob: it stands :data:`STARE_DISTANCE`
+        R from the blob's centroid on its own side and faces the centroid for
+        :data:`STARE_PERIODS` plan periods; a blob left after that gets another turn."""
+        away = position - centre
+        gap = float(np.linalg.norm(away))
+        distance = STARE_DISTANCE * self.scenario.range
+        side = away / gap if gap > 1e-9 else np.array([1.0, 0.0])  # a camera never sees what it stands on
+        stand = centre + side * distance
+        bearing = math.atan2(centre[1] - stand[1], centre[0] - stand[0])
+        points = np.array([position, stand])
+        length = float(np.linalg.norm(stand - position))
+        return Route.of(points, cleanup=True, stops=[Stop(length, [bearing] * STARE_PERIODS)])
 
     def _unclaimed(self, lack: np.ndarray, ids: list[int]) -> np.ndarray:
         """Υ without the strips that robots still on their route will sweep (half a spacing each side of

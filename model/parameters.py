@@ -15,6 +15,7 @@ from model.exact_coverage import ExactKernel, exact_kernel
 from model.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
 from model.scenario_safety import point_speed
+from model.stations import FACE_RADIUS
 from model.step import LawParameters
 from model.weave import sweep_of
 from model.world import world_of
@@ -22,7 +23,7 @@ from model.world import world_of
 
 def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParameters:
     """The control and sensing parameters of a scenario."""
-    sweep = sweep_of(scenario) if scenario.controller == "anicov" else None
+    sweep = sweep_of(scenario) if scenario.controller == "anicov" and not scenario.stations else None
     return LawParameters(
         sensing_range=scenario.range,
         half_angle=scenario.half_angle,
@@ -38,6 +39,7 @@ def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParamete
         pursuit=scenario.controller == "anicov",
         weave_amplitude=sweep.amplitude if sweep else 0.0,
         weave_wavelength=sweep.wavelength if sweep else 1.0,
+        face_radius=FACE_RADIUS if scenario.controller == "anicov" and scenario.stations else 0.0,
     )
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import cv2
@@ -76,6 +76,15 @@ def lead_in(scenario: Scenario, spacing: float) -> float:
 
 
 @dataclass
+class Stop:
+    """A station on a route (:mod:`model.stations`): where it lies (arc length along the route) and the
+    bearings (radians) left to face there, one per plan period."""
+
+    at: float
+    bearings: list[float] = field(default_factory=list)
+
+
+@dataclass
 class Route:
     """A robot's polyline and how far along it (arc length) the robot has come."""
 
@@ -83,14 +92,15 @@ class Route:
     along: np.ndarray  # (K,) cumulative arc length
     progress: float = 0.0
     cleanup: bool = False  # a pass over a blob (True) or the robot's piece of the lanes
+    stops: list[Stop] = field(default_factory=list)  # stations still to stand at, in route order
 
     @classmethod
-    def of(cls, points: np.ndarray, cleanup: bool = False) -> Route:
+    def of(cls, points: np.ndarray, cleanup: bool = False, stops: list[Stop] | None = None) -> Route:
         points = np.asarray(points, dtype=np.float64)
         keep = np.concatenate([[True], np.linalg.norm(np.diff(points, axis=0), axis=1) > 1e-9])
         points = points[keep]
         along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
-        return cls(points, along, 0.0, cleanup)
+        return cls(points, along, 0.0, cleanup, [Stop(stop.at, list(stop.bearings)) for stop in stops or []])
 
     @property
     def length(self) -> float:
@@ -106,8 +116,10 @@ class Route:
         """Progress := the nearest point of the route to ``position`` at most ``window`` ahead of where
         it was: no farther than the carrot the robot was given (so a neighbouring ring is never taken,
         nor, on a pass that doubles back over a small blob, the way back while it is still going out);
-        the first such along the route on a tie."""
+        the first such along the route on a tie; never past a stop not yet done."""
         reach = self.progress + window
+        if self.stops:
+            reach = min(reach, self.stops[0].at)
         best, best_distance = self.progress, math.inf
         for k in range(len(self.points) - 1):
             start, end = self.along[k], self.along[k + 1]
@@ -120,7 +132,39 @@ class Route:
         self.progress = max(self.progress, best)
 
     def done(self) -> bool:
-        return self.progress >= self.length - 1e-6
+        return self.progress >= self.length - 1e-6 and not self.stops
+
+    def carrot(self, position: np.ndarray, lookahead: float, face_radius: float) -> np.ndarray:
+        """The carrot for the coming plan period (after :meth:`advance`): ``lookahead`` ahead along the
+        route, held at the next stop; at a stop (the robot within ``face_radius`` of it), a point
+        ``face_radius`` / 2 from the robot in the next bearing to face there, which the law turns toward
+        (:func:`model.control.pursuit_law`), that bearing then done."""
+        if self.stops:
+            stop = self.stops[0]
+            station = self.point_at(stop.at)
+            if float(np.linalg.norm(position - station)) < face_radius or not stop.bearings:
+                # There (the law stands within ``face_radius`` of a carrot, so progress may stop short).
+                self.progress = max(self.progress, stop.at)
+                if not stop.bearings:
+                    self.stops.pop(0)
+                    return self.carrot(position, lookahead, face_radius)
+                bearing = stop.bearings.pop(0)
+                if not stop.bearings:
+                    self.stops.pop(0)
+                return np.asarray(position, dtype=np.float64) + 0.5 * face_radius * np.array(
+                    [math.cos(bearing), math.sin(bearing)]
+                )
+        ahead = self.progress + lookahead
+        if self.stops:
+            ahead = min(ahead, self.stops[0].at)
+        target = self.point_at(ahead)
+        if float(np.linalg.norm(target - position)) < face_radius:
+            # The law would stand here (a carrot this near is a bearing): at the route's end it is done (at
+            # the next plan); where the route doubles back past the robot, it has come this far.
+            self.progress = self.length if ahead >= self.length - 1e-9 else ahead
+            if ahead < self.length - 1e-9 and not (self.stops and ahead >= self.stops[0].at):
+                return self.carrot(position, lookahead, face_radius)
+        return target
 
     def nearest(self, position: np.ndarray) -> tuple[float, float]:
         """(distance, arc length) of the route's point nearest to ``position``, the first on a tie."""

@@ -62,6 +62,7 @@ class Scenario:
     controller: str = "paper"
     replan_period: float = 5.0
     weave: bool = True  # anicov: robots weave their heading where that sweeps faster (model.weave); false: straight
+    stations: bool = False  # anicov: robots stand at stations and turn their camera, hopping between (model.stations)
     # Terrain (issue 11); the defaults are the paper's open world and leave every run as it was.
     map: str = ""  # a ROS map YAML, absolute (the file names it relative to itself); "" = none
     obstacles: tuple[tuple[tuple[float, float], ...], ...] = ()  # polygons [[x, y], ...]
@@ -120,7 +121,7 @@ class Scenario:
         for key in TERRAIN_KEYS:
             if getattr(self, key) == getattr(_OPEN_WORLD, key) or (key == "occlusion" and not self.has_terrain):
                 del values[key]
-        for key in ("weave", *UNIT_KEYS, *RADIO_DEFAULTS):
+        for key in ("weave", "stations", *UNIT_KEYS, *RADIO_DEFAULTS):
             if getattr(self, key) == getattr(_OPEN_WORLD, key):
                 del values[key]
         for key in SAFETY_DEFAULTS:
@@ -229,7 +230,7 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
                     f"scenario key 'controller': expected one of {', '.join(CONTROLLER_CHOICES)}, got {value!r}"
                 )
             resolved[key] = BEST_CONTROLLER if value == "best" else value
-        elif key == "weave":
+        elif key in ("weave", "stations"):
             resolved[key] = _boolean(key, value)
         elif key == "half_angle_deg":
             angle = _number(key, value)

@@ -37,6 +37,7 @@ class LawParameters(NamedTuple):
     pursuit: bool = False  # the anicov controller: pure pursuit of a carrot (model.control.pursuit_law)
     weave_amplitude: float = 0.0  # the anicov controller's weave, radians (model.weave; 0: straight)
     weave_wavelength: float = 1.0  # its wavelength, units
+    face_radius: float = 0.0  # the anicov controller's stations: a carrot this near is a bearing to face (0: none)
 
 
 @njit(cache=True)
@@ -80,7 +81,7 @@ def pursue(
     ``law``'s gains, time step and weave."""
     return pursuit_law(
         x, y, theta, objective_x, objective_y, law.k_v, law.k_omega, law.dt, law.weave_amplitude,
-        law.weave_wavelength,
+        law.weave_wavelength, law.face_radius,
     )  # fmt: skip
 
 

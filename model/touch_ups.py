@@ -32,7 +32,7 @@ from model.coverage_map import add_window
 from model.dynamics import unicycle_step
 from model.ground import open_ground
 from model.parameters import coverage_map_of, law_parameters
-from model.routes import Route
+from model.routes import Route, Stop
 from model.scenario import Scenario
 from model.sensing import sense_wedge_among
 from model.step import pursue
@@ -66,11 +66,13 @@ def simulate_routes(
     positions: np.ndarray,
     lookahead: float,
     coverage: np.ndarray | None = None,
+    stops: list[list[Stop]] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each route flown from its robot's position as the engine flies it: every ``plan_steps`` the
     robot's progress is advanced and its carrot put ``lookahead`` ahead (model.lane_planner), every step
     :func:`model.control.pursuit_law`, the wedge's coverage (eq. 2-3) and the unicycle (eq. 1); until the
-    route is done. Robots start heading at their first carrot (the planner knows no headings). Returns
+    route is done, standing at its ``stops`` (:mod:`model.stations`) as the planner has it stand. Robots start
+    heading at their first carrot (the planner knows no headings). Returns
     (Υ after all routes, eq. 4; the coverage in ticks, ``coverage`` added to in place if given; each
     route's flight time)."""
     law = law_parameters(scenario, coverage_map_of(scenario))
@@ -78,7 +80,7 @@ def simulate_routes(
     ticks = coverage_map_of(scenario).coverage if coverage is None else coverage
     times = np.zeros(len(routes))
     for index, points in enumerate(routes):
-        route = Route.of(points)
+        route = Route.of(points, stops=None if stops is None else stops[index])
         x, y = float(positions[index][0]), float(positions[index][1])
         carrot = route.point_at(lookahead)
         theta = math.atan2(carrot[1] - y, carrot[0] - x)
@@ -88,7 +90,7 @@ def simulate_routes(
                 route.advance(np.array([x, y]), lookahead)
                 if route.done():
                     break
-                carrot = route.point_at(route.progress + lookahead)
+                carrot = route.carrot(np.array([x, y]), lookahead, law.face_radius)
             v, omega = pursue(x, y, theta, carrot[0], carrot[1], law)
             _, _, _, row0, col0, window = sense_wedge_among(
                 ticks, law.target_ticks, x, y, theta, law.sensing_range, law.half_angle, law.alpha_max,
@@ -143,15 +145,21 @@ def orbit_for(scenario: Scenario, coverage: np.ndarray, spot: np.ndarray, lookah
 
 
 def with_touch_ups(
-    scenario: Scenario, routes: list[np.ndarray], positions: np.ndarray, lookahead: float, spacing: float
+    scenario: Scenario,
+    routes: list[np.ndarray],
+    positions: np.ndarray,
+    lookahead: float,
+    spacing: float,
+    stops: list[list[Stop]] | None = None,
 ) -> tuple[list[np.ndarray], list[list[TouchUp]]]:
     """``routes`` with an orbit (:func:`orbit_for`) for every group of cells they will leave short
     (:func:`simulate_routes`, grouped as :func:`blob_labels` does), and each robot's :class:`TouchUp`
     list in route order. Each in turn, of all the groups and robots, the pair that ends soonest (the
     robot's foretold flight time, the way to the orbit at k_v, its turns at the time one turn takes) is
     taken, as a greedy schedule would; the orbit is appended to the robot's route. A team of one also
-    weighs going out to the orbit from its route's nearest point and back (:func:`_cheapest`)."""
-    lack, coverage, finish = simulate_routes(scenario, routes, positions, lookahead)
+    weighs going out to the orbit from its route's nearest point and back (:func:`_cheapest`), unless its
+    route has ``stops`` (:mod:`model.stations`), whose places along it an orbit put inside would move."""
+    lack, coverage, finish = simulate_routes(scenario, routes, positions, lookahead, stops=stops)
     count, labels = blob_labels(lack > 0.0, scenario.cell, spacing)
     spots = [labels == k for k in range(1, count) if (labels == k).any()]
     touch_ups: list[list[TouchUp]] = [[] for _ in routes]
@@ -162,7 +170,7 @@ def with_touch_ups(
     orbits = [orbit_for(scenario, coverage, spot, lookahead) for spot in spots]
     routes = [np.asarray(route, dtype=np.float64) for route in routes]
     while orbits:
-        ends, k, robot, at = _cheapest(orbits, routes, finish, turn_time, scenario.k_v)
+        ends, k, robot, at = _cheapest(orbits, routes, finish, turn_time, scenario.k_v, detours=stops is None)
         (centre, turns), spot = orbits.pop(k), spots.pop(k)
         _place(routes, touch_ups, robot, centre, turns, spot, at)
         finish[robot] = ends
@@ -170,7 +178,12 @@ def with_touch_ups(
 
 
 def _cheapest(
-    orbits: list[tuple[np.ndarray, int]], routes: list[np.ndarray], finish: np.ndarray, turn_time: float, k_v: float
+    orbits: list[tuple[np.ndarray, int]],
+    routes: list[np.ndarray],
+    finish: np.ndarray,
+    turn_time: float,
+    k_v: float,
+    detours: bool = True,
 ) -> tuple[float, int, int, float | None]:
     """(when it ends, orbit, robot, where along the route it leaves for it: None for the route's end) of
     the soonest-ending orbit and robot. Only a team of one leaves its route for an orbit and comes back:
@@ -184,7 +197,7 @@ def _cheapest(
             ends = float(finish[robot]) + way + turns * turn_time
             if best is None or ends < best[0] - 1e-9:
                 best = (ends, k, robot, None)
-            if len(routes) == 1 and len(points) > 2:
+            if detours and len(routes) == 1 and len(points) > 2:
                 route = Route.of(points)
                 at = max(route.nearest(centre)[1], float(route.along[1]))  # not on the way to the spiral
                 gap = float(np.linalg.norm(route.point_at(at) - centre))

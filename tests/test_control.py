@@ -63,3 +63,19 @@ def test_no_local_error_follows_global_law():
     v, omega = combined_law(0.0, 0.0, 1.0, 0.0, 0.8, 0.5, 1.0, 1.0, 1.0, False)
     assert omega == pytest.approx(0.5)
     assert v == pytest.approx(0.8 * (1 - (2 / math.pi) * 0.5))
+
+
+def test_pursuit_law_stands_and_turns_toward_a_carrot_within_the_face_radius():
+    from model.control import pursuit_law
+
+    # A carrot 0.02 away at bearing 1 rad: stand, turn toward it at the bound (π k_ω), not beyond it.
+    v, omega = pursuit_law(5.0, 5.0, 0.0, 5.0 + 0.02 * math.cos(1.0), 5.0 + 0.02 * math.sin(1.0), 1.0, 1.0, 0.1,
+                           0.0, 1.0, 0.05)  # fmt: skip
+    assert v == 0.0
+    assert omega == pytest.approx(math.pi)
+    v, omega = pursuit_law(5.0, 5.0, 0.0, 5.0 + 0.02 * math.cos(-0.1), 5.0 + 0.02 * math.sin(-0.1), 1.0, 1.0, 0.1,
+                           0.0, 1.0, 0.05)  # fmt: skip
+    assert (v, omega) == (0.0, pytest.approx(-1.0))  # reaches the bearing within the step
+    # Without a face radius the same carrot is a place to drive to.
+    v, _ = pursuit_law(5.0, 5.0, 1.0, 5.0 + 0.02 * math.cos(1.0), 5.0 + 0.02 * math.sin(1.0), 1.0, 1.0, 0.1)
+    assert v > 0.0

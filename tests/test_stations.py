@@ -1,0 +1,96 @@
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from model.routes import Route, Stop
+from model.scenario import load_scenario
+from model.stations import BEARINGS, FACE_RADIUS, bearing_sequence, grid, layout, station_routes, timeline
+from model.touch_ups import simulate_routes
+
+PAPER = Path(__file__).resolve().parents[1] / "scenarios" / "paper.toml"
+STEP = 2.0 * math.pi / BEARINGS
+
+
+def paper(agents: int = 4):
+    return dataclasses.replace(load_scenario(PAPER), controller="anicov", stations=True, agents=agents)
+
+
+def test_grid_is_a_serpentine_inside_the_margin():
+    points = grid(100.0, 100.0, 25.0, 3.0, by_columns=False)
+    assert len(points) == 25
+    assert points.min() == 3.0 and points.max() == 97.0
+    hops = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    assert np.allclose(hops, 23.5)  # row by row, turning at each row's end: no diagonal hop
+    columns = grid(100.0, 50.0, 25.0, 3.0, by_columns=True)
+    assert np.allclose(np.diff(columns[:3, 0]), 0.0)  # column by column
+
+
+def test_bearing_sequence_sweeps_the_needed_bearings_once():
+    periods = np.zeros(BEARINGS, dtype=int)
+    periods[[14, 15, 0, 1]] = [1, 2, 1, 3]  # a fan across bearing 0
+    sequence = bearing_sequence(periods)
+    assert [round(b / STEP) % BEARINGS for b in sequence] == [14, 15, 15, 0, 1, 1, 1]
+    # From the other end when the robot comes in facing it, and one more period facing the way out.
+    back = bearing_sequence(periods, arrive=1 * STEP, leave=8 * STEP)
+    assert [round(b / STEP) % BEARINGS for b in back] == [1, 1, 1, 0, 15, 15, 14, 8]
+    # Bearings more than a period's turn (90°) apart get one in between.
+    apart = np.zeros(BEARINGS, dtype=int)
+    apart[[0, 6]] = 1
+    assert [round(b / STEP) % BEARINGS for b in bearing_sequence(apart)] == [0, 4, 6]
+    assert bearing_sequence(np.zeros(BEARINGS, dtype=int)) == []
+
+
+def test_layout_and_timeline_hold_every_period():
+    scenario = paper()
+    chosen = layout(scenario, by_columns=False)
+    assert len(chosen.stations) == len(chosen.bearings) == 25
+    periods = sum(len(b) for b in chosen.bearings)
+    line = timeline(chosen.stations, chosen.bearings, scenario.k_v)
+    hops = float(np.linalg.norm(np.diff(chosen.stations, axis=0), axis=1).sum())
+    assert line.length == pytest.approx(hops + periods * 0.5)
+
+
+@pytest.mark.parametrize("agents", [1, 4])
+def test_station_routes_share_out_every_period_and_cover_the_domain(agents):
+    scenario = paper(agents)
+    positions = np.random.default_rng(3).uniform(0.0, 100.0, (agents, 2))
+    routes, stops, finish = station_routes(scenario, positions)
+    assert finish > 0.0
+    assert len(routes) == len(stops) == agents
+    for route, position in zip(routes, positions, strict=True):
+        assert np.allclose(route[0], position)
+    shared = sum(len(stop.bearings) for robot in stops for stop in robot)
+    expected = [sum(len(b) for b in layout(scenario, by_columns).bearings) for by_columns in (False, True)]
+    assert any(abs(shared - e) <= agents for e in expected)  # a cut rounds to whole periods
+    lack, _, _ = simulate_routes(scenario, routes, positions, 2.0, stops=stops)
+    assert (lack > 0.0).mean() < 0.01  # the programme's stares and hops, flown by the law, leave almost nothing
+
+
+def test_route_stands_at_its_stop_for_each_bearing_then_goes_on():
+    route = Route.of(np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]]), stops=[Stop(10.0, [0.5, 1.0])])
+    route.progress = 5.0
+    assert np.allclose(route.carrot(np.array([5.0, 0.0]), 2.0, FACE_RADIUS), [7.0, 0.0])
+    route.progress = 9.0
+    route.advance(np.array([9.5, 0.0]), 2.0)
+    assert np.allclose(route.carrot(np.array([9.5, 0.0]), 2.0, FACE_RADIUS), [10.0, 0.0])  # held at the stop
+    at = np.array([10.0, 0.01])
+    first = route.carrot(at, 2.0, FACE_RADIUS)
+    assert np.linalg.norm(first - at) < FACE_RADIUS
+    assert math.atan2(*(first - at)[::-1]) == pytest.approx(0.5)
+    assert not route.done()
+    second = route.carrot(at, 2.0, FACE_RADIUS)
+    assert math.atan2(*(second - at)[::-1]) == pytest.approx(1.0)
+    assert not route.stops
+    route.advance(at, 2.0)
+    assert np.allclose(route.carrot(at, 2.0, FACE_RADIUS), [10.0, 2.01])  # on along the route
+
+
+def test_route_doubling_back_past_the_robot_never_leaves_it_standing():
+    route = Route.of(np.array([[0.0, 0.0], [0.0, 11.0], [0.0, 0.0], [20.0, 0.0]]))
+    at = np.array([0.0, 10.0])
+    route.advance(at, 2.0)
+    carrot = route.carrot(at, 2.0, FACE_RADIUS)
+    assert np.linalg.norm(carrot - at) >= FACE_RADIUS
