@@ -52,7 +52,8 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from model.objectives import BlobObjectives
-from model.routes import Route, Stop, balanced_routes, lead_in
+from model.route import Route, Stop
+from model.routes import balanced_routes, lead_in
 from model.scenario import Scenario
 from model.stations import FACE_RADIUS, station_routes
 from model.touch_ups import TouchUp, blob_labels, with_touch_ups
@@ -172,8 +173,9 @@ class LanePlanner:
                 continue
             gap, at = route.nearest(positions[index])
             route.progress = at
+            route.stops = [stop for stop in route.stops if stop.at > at + 1e-9]  # stood at before the loss
             if gap > self.spacing / 2.0 or not self._left_to_cover(lack, route):
-                route.progress = route.length
+                route.progress, route.stops = route.length, []
 
     def _left_to_cover(self, lack: np.ndarray, route: Route) -> bool:
         """Whether an uncovered cell lies within half a spacing of the route from its progress on."""

@@ -32,7 +32,7 @@ from model.coverage_map import add_window
 from model.dynamics import unicycle_step
 from model.ground import open_ground
 from model.parameters import coverage_map_of, law_parameters
-from model.routes import Route, Stop
+from model.route import Route, Stop
 from model.scenario import Scenario
 from model.sensing import sense_wedge_among
 from model.step import pursue

@@ -29,7 +29,8 @@ from numba import njit
 from model.control import pursuit_law
 from model.dynamics import unicycle_step
 from model.metrics import pass_reach
-from model.routes import CENTRE_ALLOWANCE_LEADS, Route, best_lane_spacing, spiral_in
+from model.route import Route
+from model.routes import CENTRE_ALLOWANCE_LEADS, best_lane_spacing, spiral_in
 from model.scenario import CARROT_PERIOD, Scenario
 from model.sensing import offset_from_heading, sensing_ability, wedge_reach
 

@@ -16,7 +16,7 @@ from model.geometry import wrap_angle
 from model.lane_planner import LOOKAHEAD, LanePlanner, blob_passes
 from model.scenario import Scenario, ScenarioError, load_scenario
 
-PAPER = Scenario()
+PAPER = Scenario(stations=False)  # the spiral (tests/test_stations.py has the stations)
 
 
 def test_a_team_on_a_long_strip_finishes_its_last_small_blobs():

@@ -5,7 +5,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model.routes import Route, Stop
+from model.lane_planner import LOOKAHEAD, STARE_DISTANCE, STARE_PERIODS, LanePlanner
+from model.route import Route, Stop
 from model.scenario import load_scenario
 from model.stations import BEARINGS, FACE_RADIUS, bearing_sequence, grid, layout, station_routes, timeline
 from model.touch_ups import simulate_routes
@@ -29,17 +30,19 @@ def test_grid_is_a_serpentine_inside_the_margin():
 
 
 def test_bearing_sequence_sweeps_the_needed_bearings_once():
+    last = BEARINGS - 1
     periods = np.zeros(BEARINGS, dtype=int)
-    periods[[14, 15, 0, 1]] = [1, 2, 1, 3]  # a fan across bearing 0
+    periods[[last - 1, last, 0, 1]] = [1, 2, 1, 3]  # a fan across bearing 0
     sequence = bearing_sequence(periods)
-    assert [round(b / STEP) % BEARINGS for b in sequence] == [14, 15, 15, 0, 1, 1, 1]
+    assert [round(b / STEP) % BEARINGS for b in sequence] == [last - 1, last, last, 0, 1, 1, 1]
     # From the other end when the robot comes in facing it, and one more period facing the way out.
-    back = bearing_sequence(periods, arrive=1 * STEP, leave=8 * STEP)
-    assert [round(b / STEP) % BEARINGS for b in back] == [1, 1, 1, 0, 15, 15, 14, 8]
+    back = bearing_sequence(periods, arrive=1 * STEP, leave=math.pi)
+    assert [round(b / STEP) % BEARINGS for b in back] == [1, 1, 1, 0, last, last, last - 1, BEARINGS // 2]
     # Bearings more than a period's turn (90°) apart get one in between.
+    step = BEARINGS // 4
     apart = np.zeros(BEARINGS, dtype=int)
-    apart[[0, 6]] = 1
-    assert [round(b / STEP) % BEARINGS for b in bearing_sequence(apart)] == [0, 4, 6]
+    apart[[0, step + 2]] = 1
+    assert [round(b / STEP) % BEARINGS for b in bearing_sequence(apart)] == [0, step, step + 2]
     assert bearing_sequence(np.zeros(BEARINGS, dtype=int)) == []
 
 
@@ -94,3 +97,31 @@ def test_route_doubling_back_past_the_robot_never_leaves_it_standing():
     route.advance(at, 2.0)
     carrot = route.carrot(at, 2.0, FACE_RADIUS)
     assert np.linalg.norm(carrot - at) >= FACE_RADIUS
+
+
+def test_the_planner_leads_robots_to_their_stations_and_a_robot_with_nothing_left_stays():
+    scenario = paper(2).with_overrides(domain=[40.0, 40.0])
+    planner = LanePlanner(scenario)
+    positions = np.array([[5.0, 5.0], [35.0, 30.0]])
+    targets = planner.plan(np.ones(scenario.grid_shape), positions)
+    for agent in (0, 1):
+        route = planner.routes[agent]
+        assert route.stops  # each has stations to stand at
+        assert np.allclose(targets[agent], route.point_at(min(route.progress + LOOKAHEAD, route.stops[0].at)))
+    for route in planner.routes.values():
+        route.progress, route.stops = route.length, []  # both done, nothing uncovered
+    assert np.allclose(planner.plan(np.zeros(scenario.grid_shape), positions), positions)
+
+
+def test_a_free_robot_stares_at_a_blob_from_a_quarter_range_on_its_side():
+    scenario = paper(1).with_overrides(domain=[40.0, 40.0])
+    planner = LanePlanner(scenario)
+    planner.routes[0] = Route.of(np.array([[2.0, 20.0]]))  # done with its route
+    lack = np.zeros(scenario.grid_shape)
+    lack[19:22, 29:32] = 1.0  # a blob about (30.5, 20.5)
+    planner.plan(lack, np.array([[2.0, 20.0]]))
+    route = planner.routes[0]
+    stand = route.point_at(route.stops[0].at)
+    assert np.linalg.norm(stand - [30.5, 20.5]) == pytest.approx(STARE_DISTANCE * scenario.range)
+    assert stand[0] < 30.5  # on the robot's side
+    assert route.stops[0].bearings == [pytest.approx(math.atan2(20.5 - stand[1], 30.5 - stand[0]))] * STARE_PERIODS

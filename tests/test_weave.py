@@ -9,12 +9,13 @@ import pytest
 
 from model import lane_planner, weave
 from model.metrics import pass_reach, straight_pass_coverage
-from model.routes import CENTRE_ALLOWANCE_LEADS, Route, best_lane_spacing, spiral_in
+from model.route import Route
+from model.routes import CENTRE_ALLOWANCE_LEADS, best_lane_spacing, spiral_in
 from model.scenario import Scenario, ScenarioError, load_scenario
 from model.touch_ups import simulate_routes
 from model.weave import MARGIN, WEAVE_CENTRE_LEADS, PassLaw, one_pass_reach, pass_profile, sweep_of, two_pass_spacing
 
-PAPER = Scenario().with_overrides(controller="anicov")
+PAPER = Scenario().with_overrides(controller="anicov", stations=False)  # the spiral's passes weave
 WIDE = load_scenario(Path(__file__).resolve().parent.parent / "scenarios" / "wide.toml").with_overrides(
     controller="anicov"
 )
