@@ -48,14 +48,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from model.objectives import BlobObjectives
-from model.route import Route, Stop
+from model.route import FACE_RADIUS, Route, Stop
 from model.routes import balanced_routes, lead_in
 from model.scenario import Scenario
-from model.stations import FACE_RADIUS, station_routes
+from model.stations import station_routes
 from model.touch_ups import TouchUp, blob_labels, with_touch_ups
 from model.weave import sweep_of
 
@@ -104,6 +105,7 @@ class LanePlanner:
     blobs: BlobObjectives = field(default_factory=BlobObjectives)
     routes: dict[int, Route] = field(default_factory=dict)
     touch_ups: dict[int, list[TouchUp]] = field(default_factory=dict)
+    stared: dict[int, np.ndarray] = field(default_factory=dict)  # stations: each robot's last stare (x, y, Σ Υ)
 
     def __post_init__(self) -> None:
         self.sweep = sweep_of(self.scenario)
@@ -173,14 +175,19 @@ class LanePlanner:
                 continue
             gap, at = route.nearest(positions[index])
             route.progress = at
-            route.stops = [stop for stop in route.stops if stop.at > at + 1e-9]  # stood at before the loss
+            # Stations stood at before the loss are done; the one it stands at (or was reaching) is done again.
+            route.stops = [stop for stop in route.stops if stop.at > at - FACE_RADIUS]
             if gap > self.spacing / 2.0 or not self._left_to_cover(lack, route):
                 route.progress, route.stops = route.length, []
 
     def _left_to_cover(self, lack: np.ndarray, route: Route) -> bool:
-        """Whether an uncovered cell lies within half a spacing of the route from its progress on."""
+        """Whether an uncovered cell lies within half a spacing of the route from its progress on, or within
+        R of a station it has yet to stand at (its camera turns there)."""
         strip = np.zeros(lack.shape, dtype=np.uint8)
         route.draw_ahead(strip, self.scenario.cell, self._strip_cells())
+        for stop in route.stops:
+            centre = np.round(route.point_at(stop.at) / self.scenario.cell).astype(np.int32)
+            cv2.circle(strip, (int(centre[0]), int(centre[1])), round(self.scenario.range / self.scenario.cell), 1, -1)
         return bool((lack[strip.astype(bool)] > 0.0).any())
 
     def _strip_cells(self) -> int:
@@ -211,11 +218,24 @@ class LanePlanner:
         robots, chosen = linear_sum_assignment(distance.min(axis=2))
         for robot, blob in zip(robots, chosen, strict=True):
             index = free[robot]
-            if self.scenario.stations:
-                self.routes[ids[index]] = self._stare_at(positions[index], centres[blob])
+            if self.scenario.stations and self._may_stare(ids[index], positions[index], centres[blob], lack):
                 continue
             entry, exit_ = ways[blob, int(np.argmin(distance[robot, blob]))]
             self.routes[ids[index]] = Route.of(np.array([positions[index], entry, exit_]), cleanup=True)
+
+    def _may_stare(self, agent: int, position: np.ndarray, centre: np.ndarray, lack: np.ndarray) -> bool:
+        """Give ``agent`` a stare at the blob about ``centre`` (:meth:`_stare_at`), unless it would be the
+        stare it was given last, from the same place, and nothing was covered since: what a blob's remnant
+        can leave (two scraps at its ends, their centroid the same, out of the wedge's sides) would then keep
+        it staring for ever; it flies the blob's pass instead (False)."""
+        route = self._stare_at(position, centre)
+        stand, total = route.point_at(route.length), float(lack.sum())
+        last = self.stared.get(agent)
+        if last is not None and float(np.linalg.norm(stand - last[:2])) < FACE_RADIUS and total >= last[2]:
+            return False
+        self.stared[agent] = np.array([stand[0], stand[1], total])
+        self.routes[agent] = route
+        return True
 
     def _stare_at(self, position: np.ndarray, centre: np.ndarray) -> Route:
         """With stations (:mod:`model.stations`), a robot's turn at a blob: it stands :data:`STARE_DISTANCE`

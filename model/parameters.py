@@ -12,10 +12,10 @@ import numpy as np
 from model.clearance import disk_is_free
 from model.coverage_map import CoverageMap
 from model.exact_coverage import ExactKernel, exact_kernel
+from model.route import FACE_RADIUS
 from model.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
 from model.scenario_safety import point_speed
-from model.stations import FACE_RADIUS
 from model.step import LawParameters
 from model.weave import sweep_of
 from model.world import world_of

@@ -15,6 +15,11 @@ import numpy as np
 
 from model.zigzag import point_along
 
+FACE_RADIUS = 0.05
+"""A carrot nearer the robot than this is a bearing to face (units; :func:`model.control.pursuit_law`, the
+stations of :mod:`model.stations`): half a step at k_v = 1, dt = 0.1, which the pursuit's last step toward a
+station reaches (v = d/dt within one step of it)."""
+
 
 @dataclass
 class Stop:

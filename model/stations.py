@@ -47,9 +47,6 @@ from model.scenario import CARROT_PERIOD, Scenario
 from model.sensing import sense_wedge_among
 from model.zigzag import point_along
 
-FACE_RADIUS = 0.05
-"""A carrot nearer the robot than this is a bearing to face (units): half a step at k_v = 1, dt = 0.1, which
-the pursuit's last step toward a station reaches (v = d/dt within one step of it)."""
 BEARINGS = 24
 """Bearings a robot at a station may face (15° apart): the wedge (2F = 54° on the paper's sensor) laid at
 neighbouring bearings overlaps, so their stares add up to a smooth fan. Measured (6 seeds, the paper's
@@ -65,13 +62,14 @@ counts, and a cell left a few per cent short costs an orbit or a stare later. Me
 seeds, the paper's square, N = 4 / 10): 1.03 2.40 / 2.54 t*, 1.08 2.29 / 2.48, 1.12 2.27 / 2.47, 1.18 2.37 /
 2.52."""
 TURN_PER_PERIOD = math.pi / 2
-"""The most a robot turns in one plan period at the bound π k_ω (k_ω = 1, 0.5 time units)."""
+"""The most a robot turns in one plan period at the bound π k_ω, for k_ω = 1 (the layout passes its
+scenario's)."""
 
 
 @dataclass(frozen=True)
 class Layout:
     """Stations in the order flown (K, 2) and, for each, the bearings (radians) it faces, one per plan
-    period; the time (units of k_v travel) its hops take."""
+    period."""
 
     stations: np.ndarray
     bearings: tuple[tuple[float, ...], ...]
@@ -102,12 +100,14 @@ def grid(width: float, height: float, spacing: float, margin: float, by_columns:
     return np.array(points, dtype=np.float64)
 
 
-def bearing_sequence(periods: np.ndarray, arrive: float | None = None, leave: float | None = None) -> list[float]:
+def bearing_sequence(
+    periods: np.ndarray, arrive: float | None = None, leave: float | None = None, turn: float = TURN_PER_PERIOD
+) -> list[float]:
     """The bearings (radians) to face, one per period, for ``periods`` (BEARINGS,) periods at each: one sweep
     over the bearings needed, from the one after the largest gap between them counterclockwise (or back from
     its other end, clockwise, whichever turns less from ``arrive``, the heading the robot comes in with, and
     to ``leave``, the way to the next station), with a bearing put in wherever two needed ones lie more than
-    a period's turn apart, and one period facing ``leave`` at the end where the last bearing is more than a
+    a period's ``turn`` apart, and one period facing ``leave`` at the end where the last bearing is more than a
     bearing's step from it (the law backs up toward a carrot behind it)."""
     width = 2.0 * math.pi / BEARINGS
     needed = [b for b in range(BEARINGS) if periods[b] > 0]
@@ -117,7 +117,7 @@ def bearing_sequence(periods: np.ndarray, arrive: float | None = None, leave: fl
     _, widest = max(gaps)
     start = needed[(widest + 1) % len(needed)]
     span = (needed[widest] - start) % BEARINGS
-    step = max(1, int(TURN_PER_PERIOD / width + 1e-9))
+    step = max(1, int(turn / width + 1e-9))
     sweep: list[int] = []
     last = start
     for offset in range(span + 1):
@@ -202,8 +202,9 @@ def _layout(scenario: Scenario, by_columns: bool) -> Layout:
         raise ValueError(f"no station layout covers the domain: {solved.message}")
     periods = np.ceil(solved.x.reshape(len(stations), BEARINGS) - 1e-6).astype(int)
     ways = np.arctan2(*np.diff(stations, axis=0)[:, ::-1].T) if len(stations) > 1 else np.zeros(0)
+    turn = math.pi * scenario.k_omega * CARROT_PERIOD
     bearings = tuple(
-        tuple(bearing_sequence(row, ways[k - 1] if k else None, ways[k] if k < len(ways) else None))
+        tuple(bearing_sequence(row, ways[k - 1] if k else None, ways[k] if k < len(ways) else None, turn))
         for k, row in enumerate(periods)
     )
     return Layout(stations, bearings)

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from model.lane_planner import LOOKAHEAD, STARE_DISTANCE, STARE_PERIODS, LanePlanner
-from model.route import Route, Stop
+from model.route import FACE_RADIUS, Route, Stop
 from model.scenario import load_scenario
-from model.stations import BEARINGS, FACE_RADIUS, bearing_sequence, grid, layout, station_routes, timeline
+from model.stations import BEARINGS, bearing_sequence, grid, layout, station_routes, timeline
 from model.touch_ups import simulate_routes
 
 PAPER = Path(__file__).resolve().parents[1] / "scenarios" / "paper.toml"
@@ -67,7 +67,7 @@ def test_station_routes_share_out_every_period_and_cover_the_domain(agents):
         assert np.allclose(route[0], position)
     shared = sum(len(stop.bearings) for robot in stops for stop in robot)
     expected = [sum(len(b) for b in layout(scenario, by_columns).bearings) for by_columns in (False, True)]
-    assert any(abs(shared - e) <= agents for e in expected)  # a cut rounds to whole periods
+    assert shared in expected  # a cut inside a station's periods gives each side whole periods, none twice
     lack, _, _ = simulate_routes(scenario, routes, positions, 2.0, stops=stops)
     assert (lack > 0.0).mean() < 0.01  # the programme's stares and hops, flown by the law, leave almost nothing
 
@@ -93,10 +93,12 @@ def test_route_stands_at_its_stop_for_each_bearing_then_goes_on():
 
 def test_route_doubling_back_past_the_robot_never_leaves_it_standing():
     route = Route.of(np.array([[0.0, 0.0], [0.0, 11.0], [0.0, 0.0], [20.0, 0.0]]))
+    route.progress = 10.0
     at = np.array([0.0, 10.0])
-    route.advance(at, 2.0)
-    carrot = route.carrot(at, 2.0, FACE_RADIUS)
-    assert np.linalg.norm(carrot - at) >= FACE_RADIUS
+    # 2 ahead along the route is (0, 10) again, on the way back: a carrot on the robot would leave it
+    # standing (the law faces a carrot that near) with its progress never moving on.
+    assert np.allclose(route.carrot(at, 2.0, FACE_RADIUS), [0.0, 8.0])
+    assert route.progress == pytest.approx(12.0)
 
 
 def test_the_planner_leads_robots_to_their_stations_and_a_robot_with_nothing_left_stays():
@@ -125,3 +127,23 @@ def test_a_free_robot_stares_at_a_blob_from_a_quarter_range_on_its_side():
     assert np.linalg.norm(stand - [30.5, 20.5]) == pytest.approx(STARE_DISTANCE * scenario.range)
     assert stand[0] < 30.5  # on the robot's side
     assert route.stops[0].bearings == [pytest.approx(math.atan2(20.5 - stand[1], 30.5 - stand[0]))] * STARE_PERIODS
+
+
+def test_a_stare_that_covered_nothing_is_not_given_again_from_the_same_place():
+    scenario = paper(1).with_overrides(domain=[40.0, 40.0])
+    planner = LanePlanner(scenario)
+    planner.routes[0] = Route.of(np.array([[2.0, 20.0]]))
+    lack = np.zeros(scenario.grid_shape)
+    lack[19:22, 29:32] = 1.0
+    where = np.array([[2.0, 20.0]])
+    planner.plan(lack, where)
+    stand = planner.routes[0].point_at(planner.routes[0].length)
+    planner.routes[0] = Route.of(stand[None, :])  # the stare done, and the blob as it was
+    planner.plan(lack, stand[None, :])
+    assert not planner.routes[0].stops  # the blob's pass this time
+    assert planner.routes[0].length > 0.0
+    planner.routes[0] = Route.of(stand[None, :])  # back where it stared from (as if)
+    lack[[19, 21], 29:32] = 0.0  # but something was covered since (the centroid is where it was): stare again
+    planner.plan(lack, stand[None, :])
+    assert planner.routes[0].stops
+    assert np.allclose(planner.routes[0].point_at(planner.routes[0].length), stand)
