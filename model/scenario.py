@@ -62,7 +62,7 @@ class Scenario:
     controller: str = "paper"
     replan_period: float = 5.0
     weave: bool = True  # anicov: robots weave their heading where that sweeps faster (model.weave); false: straight
-    stations: bool = False  # anicov: robots stand at stations and turn their camera, hopping between (model.stations); false: a spiral
+    stations: bool = True  # anicov: robots stand at stations and turn their camera, hopping between (model.stations); false: a spiral
     # Terrain (issue 11); the defaults are the paper's open world and leave every run as it was.
     map: str = ""  # a ROS map YAML, absolute (the file names it relative to itself); "" = none
     obstacles: tuple[tuple[tuple[float, float], ...], ...] = ()  # polygons [[x, y], ...]

@@ -57,10 +57,14 @@ def test_lockstep_over_zenoh_equals_in_process_engine_byte_for_byte(tmp_path, ag
     assert (bandwidth["bytes_out_per_step"] < 100) == (deltas == "event")
 
 
-def test_the_anicov_controller_over_zenoh_equals_the_engine_with_the_same_messages(tmp_path):
-    """controller = "best" (the anicov controller): the coordinator plans the spiral's carrots, each agent
-    pursues its own; lockstep over Zenoh is anicov run byte for byte."""
-    config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=3, seed=5, controller="best")
+@pytest.mark.parametrize("stations", [True, False])
+def test_the_anicov_controller_over_zenoh_equals_the_engine_with_the_same_messages(tmp_path, stations):
+    """controller = "best" (the anicov controller): the coordinator plans the carrots (at stations, where a
+    carrot on the robot is a bearing to face; or along the spiral), each agent pursues its own; lockstep over
+    Zenoh is anicov run byte for byte."""
+    config = write_scenario(
+        tmp_path / "s.toml", domain=[40.0, 40.0], agents=3, seed=5, controller="best", stations=stations
+    )
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
     assert engine.returncode == 0, engine.stderr
     team = unique_team()
