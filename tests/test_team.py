@@ -57,7 +57,7 @@ def test_lockstep_over_zenoh_equals_in_process_engine_byte_for_byte(tmp_path, ag
     assert (bandwidth["bytes_out_per_step"] < 100) == (deltas == "event")
 
 
-@pytest.mark.parametrize("stations", [True, False])
+@pytest.mark.parametrize("stations", [True, pytest.param(False, marks=pytest.mark.slow)])  # the spiral: 11 s, slow set
 def test_the_anicov_controller_over_zenoh_equals_the_engine_with_the_same_messages(tmp_path, stations):
     """controller = "best" (the anicov controller): the coordinator plans the carrots (at stations, where a
     carrot on the robot is a bearing to face; or along the spiral), each agent pursues its own; lockstep over
