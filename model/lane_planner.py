@@ -53,7 +53,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from model.objectives import BlobObjectives
-from model.route import FACE_RADIUS, Route, Stop
+from model.route import FACE_RADIUS, Route, Stop, face_radius_of
 from model.routes import balanced_routes, lead_in
 from model.scenario import Scenario
 from model.stations import station_routes
@@ -144,7 +144,7 @@ class LanePlanner:
                 free.append(index)
         if free:
             self._give_passes(lack, positions, ids, free)
-        face = FACE_RADIUS if self.scenario.stations else 0.0
+        face = face_radius_of(self.scenario)
         targets = np.array(
             [self.routes[agent].carrot(positions[index], LOOKAHEAD, face) for index, agent in enumerate(ids)],
             dtype=np.float64,

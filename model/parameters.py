@@ -12,7 +12,7 @@ import numpy as np
 from model.clearance import disk_is_free
 from model.coverage_map import CoverageMap
 from model.exact_coverage import ExactKernel, exact_kernel
-from model.route import FACE_RADIUS
+from model.route import face_radius_of
 from model.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
 from model.scenario_safety import point_speed
@@ -39,7 +39,7 @@ def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParamete
         pursuit=scenario.controller == "anicov",
         weave_amplitude=sweep.amplitude if sweep else 0.0,
         weave_wavelength=sweep.wavelength if sweep else 1.0,
-        face_radius=FACE_RADIUS if scenario.controller == "anicov" and scenario.stations else 0.0,
+        face_radius=face_radius_of(scenario),
     )
 
 

@@ -13,12 +13,19 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
+from model.scenario import Scenario
 from model.zigzag import point_along
 
 FACE_RADIUS = 0.05
 """A carrot nearer the robot than this is a bearing to face (units; :func:`model.control.pursuit_law`, the
 stations of :mod:`model.stations`): half a step at k_v = 1, dt = 0.1, which the pursuit's last step toward a
 station reaches (v = d/dt within one step of it)."""
+
+
+def face_radius_of(scenario: Scenario) -> float:
+    """:data:`FACE_RADIUS` where the scenario's robots stand at stations (the anicov controller's default),
+    else 0: the one rule the planner's carrots and the robots' law both read."""
+    return FACE_RADIUS if scenario.controller == "anicov" and scenario.stations else 0.0
 
 
 @dataclass
@@ -46,7 +53,8 @@ class Route:
         keep = np.concatenate([[True], np.linalg.norm(np.diff(points, axis=0), axis=1) > 1e-9])
         points = points[keep]
         along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
-        return cls(points, along, 0.0, cleanup, [Stop(stop.at, list(stop.bearings)) for stop in stops or []])
+        kept = [Stop(stop.at, list(stop.bearings)) for stop in stops or [] if stop.bearings]  # none to face: none
+        return cls(points, along, 0.0, cleanup, kept)
 
     @property
     def length(self) -> float:
@@ -85,21 +93,16 @@ class Route:
         route, held at the next stop; at a stop (the robot within ``face_radius`` of it), a point
         ``face_radius`` / 2 from the robot in the next bearing to face there, which the law turns toward
         (:func:`model.control.pursuit_law`), that bearing then done."""
-        if self.stops:
+        if self.stops and float(np.linalg.norm(position - self.point_at(self.stops[0].at))) < face_radius:
+            # There (the law stands within ``face_radius`` of a carrot, so progress may stop short).
             stop = self.stops[0]
-            station = self.point_at(stop.at)
-            if float(np.linalg.norm(position - station)) < face_radius or not stop.bearings:
-                # There (the law stands within ``face_radius`` of a carrot, so progress may stop short).
-                self.progress = max(self.progress, stop.at)
-                if not stop.bearings:
-                    self.stops.pop(0)
-                    return self.carrot(position, lookahead, face_radius)
-                bearing = stop.bearings.pop(0)
-                if not stop.bearings:
-                    self.stops.pop(0)
-                return np.asarray(position, dtype=np.float64) + 0.5 * face_radius * np.array(
-                    [math.cos(bearing), math.sin(bearing)]
-                )
+            self.progress = max(self.progress, stop.at)
+            bearing = stop.bearings.pop(0)
+            if not stop.bearings:
+                self.stops.pop(0)
+            return np.asarray(position, dtype=np.float64) + 0.5 * face_radius * np.array(
+                [math.cos(bearing), math.sin(bearing)]
+            )
         ahead = self.progress + lookahead
         if self.stops:
             ahead = min(ahead, self.stops[0].at)

@@ -178,13 +178,9 @@ class _Deposit:
         return ticks.ravel() / self.target_ticks
 
 
+@functools.cache
 def layout(scenario: Scenario, by_columns: bool) -> Layout:
     """The stations of a serpentine and the bearings each faces (the linear programme of the module)."""
-    return _layout(scenario, by_columns)
-
-
-@functools.cache
-def _layout(scenario: Scenario, by_columns: bool) -> Layout:
     width, height = scenario.domain
     stations = grid(width, height, SPACING_PER_RANGE * scenario.range, MARGIN_PER_RANGE * scenario.range, by_columns)
     deposit = _Deposit(scenario)
@@ -210,20 +206,27 @@ def _layout(scenario: Scenario, by_columns: bool) -> Layout:
     return Layout(stations, bearings)
 
 
-def timeline(stations: np.ndarray, bearings: tuple[tuple[float, ...], ...], k_v: float) -> Spiral:
-    """The serpentine as a line in time for :mod:`model.piece_order` (in units of k_v travel): each hop its
-    length, each station its periods (the station's point held for that long)."""
-    points, along, now = [], [], 0.0
-    for k, station in enumerate(stations):
+def station_times(chosen: Layout, k_v: float) -> tuple[np.ndarray, np.ndarray]:
+    """When (in units of k_v travel along the serpentine) each station is reached and left: the hops at
+    k_v, each station held for its periods."""
+    arrive, leave, now = [], [], 0.0
+    for k, station in enumerate(chosen.stations):
         if k:
-            now += float(np.linalg.norm(station - stations[k - 1]))
-        points.append(station)
-        along.append(now)
-        now += len(bearings[k]) * CARROT_PERIOD * k_v
-        points.append(station)
-        along.append(now)
+            now += float(np.linalg.norm(station - chosen.stations[k - 1]))
+        arrive.append(now)
+        now += len(chosen.bearings[k]) * CARROT_PERIOD * k_v
+        leave.append(now)
+    return np.array(arrive), np.array(leave)
+
+
+def timeline(chosen: Layout, k_v: float) -> Spiral:
+    """The serpentine as a line in time for :mod:`model.piece_order` (:func:`station_times`): each station's
+    point at its arrival and again at its leaving."""
+    arrive, leave = station_times(chosen, k_v)
+    points = np.repeat(chosen.stations, 2, axis=0)
+    along = np.stack([arrive, leave], axis=1).ravel()
     keep = np.concatenate([[True], np.diff(along) > 1e-9])
-    return Spiral(np.array(points)[keep], np.array(along)[keep], 0.0, 0.0, 0.0)
+    return Spiral(points[keep], along[keep], 0.0, 0.0, 0.0)
 
 
 def station_routes(scenario: Scenario, positions: np.ndarray) -> tuple[list[np.ndarray], list[list[Stop]], float]:
@@ -237,7 +240,7 @@ def station_routes(scenario: Scenario, positions: np.ndarray) -> tuple[list[np.n
         for flip_x in (False, True):
             for flip_y in (False, True):
                 mirrored = base.mirrored(width, height, flip_x, flip_y)
-                line = timeline(mirrored.stations, mirrored.bearings, scenario.k_v)
+                line = timeline(mirrored, scenario.k_v)
                 order = _first_order(positions, line)
                 tried.append((float(order_finishes(order[None, :], positions, line)[0]), mirrored, line, order))
     soonest = sorted(range(len(tried)), key=lambda k: tried[k][0])  # stable: the first on a tie
@@ -272,21 +275,18 @@ def _share(
     period = CARROT_PERIOD * k_v
     points = [position, point_along(line.points, line.along, start)]
     wanted: list[tuple[int, list[float]]] = []  # (index in points, bearings)
-    arrive = 0.0
-    for k, station in enumerate(chosen.stations):
-        if k:
-            arrive += float(np.linalg.norm(station - chosen.stations[k - 1]))
-        leave = arrive + len(chosen.bearings[k]) * period
+    for station, bearings, arrive, leave in zip(
+        chosen.stations, chosen.bearings, *station_times(chosen, k_v), strict=True
+    ):
         if arrive > start + 1e-9 and arrive < end - 1e-9:
             points.append(station)
-        if leave > start + 1e-9 and arrive < end - 1e-9 and chosen.bearings[k]:
+        if leave > start + 1e-9 and arrive < end - 1e-9 and bearings:
             first = max(0, round((start - arrive) / period))
-            last = min(len(chosen.bearings[k]), round((end - arrive) / period))
+            last = min(len(bearings), round((end - arrive) / period))
             if last > first:
                 if not np.allclose(points[-1], station):
                     points.append(station)
-                wanted.append((len(points) - 1, list(chosen.bearings[k][first:last])))
-        arrive = leave
+                wanted.append((len(points) - 1, list(bearings[first:last])))
     if end < line.length - 1e-9:
         points.append(point_along(line.points, line.along, end))
     route = np.array(points, dtype=np.float64)

@@ -51,7 +51,7 @@ def test_layout_and_timeline_hold_every_period():
     chosen = layout(scenario, by_columns=False)
     assert len(chosen.stations) == len(chosen.bearings) == 25
     periods = sum(len(b) for b in chosen.bearings)
-    line = timeline(chosen.stations, chosen.bearings, scenario.k_v)
+    line = timeline(chosen, scenario.k_v)
     hops = float(np.linalg.norm(np.diff(chosen.stations, axis=0), axis=1).sum())
     assert line.length == pytest.approx(hops + periods * 0.5)
 
