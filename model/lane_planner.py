@@ -56,7 +56,7 @@ from model.objectives import BlobObjectives
 from model.route import FACE_RADIUS, Route, Stop, face_radius_of
 from model.routes import balanced_routes, lead_in
 from model.scenario import Scenario
-from model.stations import station_routes
+from model.stations import station_routes, with_patched_stops
 from model.touch_ups import TouchUp, blob_labels, with_touch_ups
 from model.weave import sweep_of
 
@@ -126,6 +126,7 @@ class LanePlanner:
             stops: list[list[Stop]] | None = None
             if self.scenario.stations:
                 routes, stops, _ = station_routes(self.scenario, start)
+                stops = with_patched_stops(self.scenario, routes, stops, start, LOOKAHEAD)
             else:
                 routes = balanced_routes(
                     self.scenario, sweep.spacing, start, self.lead, sweep.reach, sweep.edge, sweep.centre_leads

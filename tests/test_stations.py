@@ -4,11 +4,24 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.sparse import csc_matrix
 
+import model.stations as stations_module
 from model.lane_planner import LOOKAHEAD, STARE_DISTANCE, STARE_PERIODS, LanePlanner
 from model.route import FACE_RADIUS, Route, Stop
 from model.scenario import load_scenario
-from model.stations import BEARINGS, bearing_sequence, grid, layout, station_routes, timeline
+from model.stations import (
+    BEARINGS,
+    SPACINGS_PER_RANGE,
+    bearing_sequence,
+    grid,
+    layout,
+    station_routes,
+    station_times,
+    timeline,
+    whole_periods,
+    with_patched_stops,
+)
 from model.touch_ups import simulate_routes
 
 PAPER = Path(__file__).resolve().parents[1] / "scenarios" / "paper.toml"
@@ -68,8 +81,38 @@ def test_station_routes_share_out_every_period_and_cover_the_domain(agents):
     shared = sum(len(stop.bearings) for robot in stops for stop in robot)
     expected = [sum(len(b) for b in layout(scenario, by_columns).bearings) for by_columns in (False, True)]
     assert shared in expected  # a cut inside a station's periods gives each side whole periods, none twice
-    lack, _, _ = simulate_routes(scenario, routes, positions, 2.0, stops=stops)
-    assert (lack > 0.0).mean() < 0.01  # the programme's stares and hops, flown by the law, leave almost nothing
+    lack, _, _ = simulate_routes(scenario, routes, positions, LOOKAHEAD, stops=stops)
+    assert 0.0 < (lack > 0.0).mean() < 0.03  # the programme's stares and hops, flown by the law, leave a little
+    patched = with_patched_stops(scenario, routes, stops, positions, LOOKAHEAD)
+    added = sum(len(stop.bearings) for robot in patched for stop in robot) - shared
+    assert 0 < added < 0.05 * shared
+    assert [[stop.at for stop in robot] for robot in patched] == [[stop.at for stop in robot] for robot in stops]
+    lack, _, _ = simulate_routes(scenario, routes, positions, LOOKAHEAD, stops=patched)
+    assert not (lack > 0.0).any()  # the periods put in where the flight fell short finish it
+
+
+def test_whole_periods_cover_every_cell_with_fewer_periods_than_rounding_up():
+    rng = np.random.default_rng(5)
+    stares = csc_matrix(rng.uniform(0.0, 1.0, (40, 12)) * (rng.uniform(size=(40, 12)) < 0.3))
+    need = np.where(np.asarray(stares.sum(axis=1)).ravel() > 0.0, 1.0, 0.0)
+    relaxed = np.full(12, 2.4)
+    periods = whole_periods(stares, need, relaxed)
+    assert periods.dtype.kind == "i"
+    assert (periods >= 2).all()  # the programme's periods rounded down are kept
+    assert (stares @ periods >= need - 1e-9).all()
+    assert periods.sum() <= np.ceil(relaxed).sum()
+
+
+def test_layout_takes_the_spacing_of_least_time():
+    scenario = paper()
+    chosen = layout(scenario, by_columns=False)
+    finishes = []
+    for share in SPACINGS_PER_RANGE:  # on the paper's square: 36 stations 22 apart, or 25 stations 23.5 apart
+        candidate = stations_module._programme(scenario, grid(100.0, 100.0, share * scenario.range, 3.0, False))
+        finishes.append((float(station_times(candidate, scenario.k_v)[1][-1]), len(candidate.stations)))
+    assert sorted(count for _, count in finishes) == [25, 36]
+    assert (float(station_times(chosen, scenario.k_v)[1][-1]), len(chosen.stations)) == min(finishes)
+    assert len(chosen.stations) == 25  # 1,175.5 time units against 1,199 (the hops of 36 cost more than they save)
 
 
 def test_route_stands_at_its_stop_for_each_bearing_then_goes_on():

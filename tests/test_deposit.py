@@ -1,0 +1,55 @@
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from model.coverage_map import add_window
+from model.deposit import Deposit
+from model.scenario import load_scenario
+from model.sensing import sense_wedge_among
+
+PAPER = Path(__file__).resolve().parents[1] / "scenarios" / "paper.toml"
+
+
+def small():
+    return dataclasses.replace(load_scenario(PAPER), controller="anicov").with_overrides(domain=[40.0, 30.0])
+
+
+def flown(scenario, poses):
+    """What the engine's sensor adds, step by step, from ``poses`` (Λ*)."""
+    deposit = Deposit(scenario)
+    ticks = np.zeros(scenario.grid_shape, dtype=np.int64)
+    for x, y, theta in poses:
+        _, _, _, row0, col0, window = sense_wedge_among(
+            ticks, 1 << 62, x, y, theta, scenario.range, scenario.half_angle, scenario.alpha_max, scenario.dt,
+            scenario.cell, deposit.ground, deposit.nobody,
+        )  # fmt: skip
+        add_window(ticks, row0, col0, window, 1 << 62)
+    return ticks.ravel() / deposit.target_ticks
+
+
+def test_a_stare_is_a_plan_period_of_the_sensor_standing_still():
+    scenario = small()
+    stare = Deposit(scenario).stare(12.3, 7.9, 0.7)
+    assert stare.sum() > 0.0
+    assert np.array_equal(stare, flown(scenario, [(12.3, 7.9, 0.7)] * scenario.plan_steps))
+
+
+def test_stares_are_the_columns_of_every_station_and_angle():
+    scenario = small()
+    deposit = Deposit(scenario)
+    stations = np.array([[5.0, 5.0], [30.0, 20.0]])
+    angles = np.array([0.0, 2.0, -2.5])
+    matrix = deposit.stares(stations, angles)
+    assert matrix.shape == (40 * 30, 6)
+    for k, (station, angle) in enumerate((s, a) for s in stations for a in angles):
+        assert np.array_equal(matrix[:, k].toarray().ravel(), deposit.stare(*station, angle))
+
+
+def test_hops_are_flown_straight_at_k_v_from_station_to_station():
+    scenario = small()
+    stations = np.array([[5.0, 5.0], [15.0, 5.0], [15.0, 20.0]])
+    steps = [(5.0 + k * 0.1, 5.0, 0.0) for k in range(100)] + [(15.0, 5.0 + k * 0.1, math.pi / 2) for k in range(150)]
+    assert Deposit(scenario).hops(stations) == pytest.approx(flown(scenario, steps))
