@@ -1,7 +1,10 @@
-"""How long the anicov controller's first plan takes: the spiral's 8 symmetries balanced, the order robots
-take the pieces of the 2 soonest searched (model.piece_order), then the routes flown once to foresee what
-they leave short and the orbits over it (model.touch_ups). In realtime the team waits this long for its
-first carrots; in lockstep and in the engine it is paid once per run.
+"""How long the anicov controller's first plan takes, with stations (its default): the stations' layouts
+(model.stations.layout: the linear programme for each spacing and both serpentines, once per process and
+scenario, timed on its own), then per team the serpentine cut for the robots on its 8 symmetries and the
+order searched on the 2 soonest (model.piece_order), the routes flown to put periods in where they fall
+short (two rounds) and once more to foresee what is left and the orbits over it (model.touch_ups). In
+realtime the team waits this long for its first carrots; in lockstep and in the engine it is paid once per
+run.
 
     .venv/bin/python bench/bench_planner.py
 """
@@ -20,6 +23,7 @@ from bench.machine import describe_machine
 from model.lane_planner import LanePlanner
 from model.parameters import starting_poses
 from model.scenario import load_scenario
+from model.stations import layout
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 CASES = [
@@ -43,9 +47,21 @@ def first_plan_seconds(config: str, agents: int, seed: int) -> tuple[float, int]
     return time.perf_counter() - started, sum(len(touch_ups) for touch_ups in planner.touch_ups.values())
 
 
+def layout_seconds(config: str) -> float:
+    """Seconds of the stations' layouts of one scenario (both serpentines), computed afresh."""
+    scenario = load_scenario(SCENARIOS / config).with_overrides(controller="anicov")
+    layout.cache_clear()
+    started = time.perf_counter()
+    for by_columns in (False, True):
+        layout(scenario, by_columns)
+    return time.perf_counter() - started
+
+
 def main() -> None:
     print(f"machine: {describe_machine()}")
     first_plan_seconds("paper.toml", 1, 0)  # numba's kernels loaded before timing
+    for config in sorted({config for config, _ in CASES}):
+        print(f"stations' layouts of {config}, once per process: {layout_seconds(config):.2f} s")
     print("| scenario | N | first plan, s (seeds 0-2) | orbits |")
     print("|---|---|---|---|")
     for config, agents in CASES:
