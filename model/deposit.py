@@ -2,8 +2,8 @@
 straight hop between stations; :mod:`model.stations`' linear programme is built from them.
 
 Beyond the paper (docs/controller.md). Each is one step of the engine's own sensor
-(:func:`model.sensing.sense_wedge_among`, in the open world, without the Λ* cap), so that what the programme
-counts is what the engine would add.
+(:func:`model.sensing.sense_wedge_among`, in the open world), so that what the programme counts is what the
+engine would add.
 """
 
 from __future__ import annotations

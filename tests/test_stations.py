@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.optimize import linprog
 from scipy.sparse import csc_matrix
 
 import model.stations as stations_module
@@ -82,10 +83,11 @@ def test_station_routes_share_out_every_period_and_cover_the_domain(agents):
     expected = [sum(len(b) for b in layout(scenario, by_columns).bearings) for by_columns in (False, True)]
     assert shared in expected  # a cut inside a station's periods gives each side whole periods, none twice
     lack, _, _ = simulate_routes(scenario, routes, positions, LOOKAHEAD, stops=stops)
-    assert 0.0 < (lack > 0.0).mean() < 0.03  # the programme's stares and hops, flown by the law, leave a little
+    assert (lack > 0.0).mean() < 0.03  # the programme's stares and hops, flown by the law, leave a little
     patched = with_patched_stops(scenario, routes, stops, positions, LOOKAHEAD)
     added = sum(len(stop.bearings) for robot in patched for stop in robot) - shared
-    assert 0 < added < 0.05 * shared
+    assert added < 0.05 * shared
+    assert (added > 0) == bool((lack > 0.0).any())
     assert [[stop.at for stop in robot] for robot in patched] == [[stop.at for stop in robot] for robot in stops]
     lack, _, _ = simulate_routes(scenario, routes, positions, LOOKAHEAD, stops=patched)
     assert not (lack > 0.0).any()  # the periods put in where the flight fell short finish it
@@ -93,21 +95,29 @@ def test_station_routes_share_out_every_period_and_cover_the_domain(agents):
 
 def test_whole_periods_cover_every_cell_with_fewer_periods_than_rounding_up():
     rng = np.random.default_rng(5)
-    stares = csc_matrix(rng.uniform(0.0, 1.0, (40, 12)) * (rng.uniform(size=(40, 12)) < 0.3))
-    need = np.where(np.asarray(stares.sum(axis=1)).ravel() > 0.0, 1.0, 0.0)
-    relaxed = np.full(12, 2.4)
+    stares = csc_matrix(rng.uniform(0.0, 1.0, (60, 12)) * (rng.uniform(size=(60, 12)) < 0.3))
+    need = np.where(np.asarray(stares.sum(axis=1)).ravel() > 0.0, 3.0, 0.0)
+    relaxed = linprog(np.ones(12), A_ub=-stares, b_ub=-need, bounds=(0, None), method="highs").x
+    assert (relaxed % 1.0 > 1e-6).sum() >= 3  # a programme with fractions to round
     periods = whole_periods(stares, need, relaxed)
     assert periods.dtype.kind == "i"
-    assert (periods >= 2).all()  # the programme's periods rounded down are kept
+    assert (periods >= np.floor(relaxed + 1e-6)).all()  # the programme's periods rounded down are kept
     assert (stares @ periods >= need - 1e-9).all()
-    assert periods.sum() <= np.ceil(relaxed).sum()
+    assert periods.sum() < np.ceil(relaxed - 1e-6).sum()
+    # The first period added is where it brings the most of what is missing.
+    missing = np.maximum(need - stares @ np.floor(relaxed + 1e-6), 0.0)
+    gains = [np.minimum(stares[:, k].toarray().ravel(), missing).sum() for k in range(12)]
+    assert periods[int(np.argmax(gains))] > np.floor(relaxed[int(np.argmax(gains))] + 1e-6)
+    with pytest.raises(ValueError, match="no stare reaches"):
+        unreached = csc_matrix(np.vstack([stares.toarray(), np.zeros((1, 12))]))  # a cell no stare reaches
+        whole_periods(unreached, np.ones(61), np.zeros(12))
 
 
 def test_layout_takes_the_spacing_of_least_time():
     scenario = paper()
     chosen = layout(scenario, by_columns=False)
     finishes = []
-    for share in SPACINGS_PER_RANGE:  # on the paper's square: 36 stations 22 apart, or 25 stations 23.5 apart
+    for share in SPACINGS_PER_RANGE:  # on the paper's square: 6 × 6 stations 18.8 apart, or 5 × 5 23.5 apart
         candidate = stations_module._programme(scenario, grid(100.0, 100.0, share * scenario.range, 3.0, False))
         finishes.append((float(station_times(candidate, scenario.k_v)[1][-1]), len(candidate.stations)))
     assert sorted(count for _, count in finishes) == [25, 36]
