@@ -200,3 +200,9 @@ def test_a_stare_that_covered_nothing_is_not_given_again_from_the_same_place():
     planner.plan(lack, stand[None, :])
     assert planner.routes[0].stops
     assert np.allclose(planner.routes[0].point_at(planner.routes[0].length), stand)
+
+
+def test_layouts_are_shared_by_every_team_seed_and_time_limit_of_a_domain():
+    first = layout(paper(4), by_columns=True)
+    assert layout(dataclasses.replace(paper(10), seed=7, max_time=50.0), by_columns=True) is first
+    assert layout(paper(4).with_overrides(range=18.0), by_columns=True) is not first  # another sensor
