@@ -1,8 +1,9 @@
 """How long the anicov controller's first plan takes, with stations (its default): the stations' layouts
 (model.stations.layout: the linear programme for each spacing and both serpentines, once per process and
 scenario, timed on its own), then per team the serpentine cut for the robots on its 8 symmetries and the
-order searched on the 2 soonest (model.piece_order), the routes flown to put periods in where they fall
-short (two rounds) and once more to foresee what is left and the orbits over it (model.touch_ups). In
+order searched on the 2 soonest (model.piece_order), the routes flown until they leave nothing short or
+twice patched (periods put in where they fall short), the last flight read for the orbits over what is left
+(model.touch_ups). In
 realtime the team waits this long for its first carrots; in lockstep and in the engine it is paid once per
 run.
 

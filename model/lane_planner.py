@@ -124,14 +124,15 @@ class LanePlanner:
             start = self._all(ids, positions)
             sweep = self.sweep
             stops: list[list[Stop]] | None = None
+            flown = None
             if self.scenario.stations:
                 routes, stops, _ = station_routes(self.scenario, start)
-                stops = with_patched_stops(self.scenario, routes, stops, start, LOOKAHEAD)
+                stops, flown = with_patched_stops(self.scenario, routes, stops, start, LOOKAHEAD)
             else:
                 routes = balanced_routes(
                     self.scenario, sweep.spacing, start, self.lead, sweep.reach, sweep.edge, sweep.centre_leads
                 )
-            routes, touch_ups = with_touch_ups(self.scenario, routes, start, LOOKAHEAD, self.spacing, stops)
+            routes, touch_ups = with_touch_ups(self.scenario, routes, start, LOOKAHEAD, self.spacing, stops, flown)
             for agent, route in zip(range(self.scenario.agents), routes, strict=True):
                 self.routes[agent] = Route.of(route, stops=None if stops is None else stops[agent])
                 self.touch_ups[agent] = touch_ups[agent]

@@ -311,23 +311,24 @@ def _share(
 
 def with_patched_stops(
     scenario: Scenario, routes: list[np.ndarray], stops: list[list[Stop]], positions: np.ndarray, lookahead: float
-) -> list[list[Stop]]:
+) -> tuple[list[list[Stop]], tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """``stops`` with periods added wherever the flight of ``routes`` (:func:`model.touch_ups.simulate_routes`,
     as the engine flies it) leaves cells short of Λ*: at a station within R of them (and no nearer than
     :data:`NEAREST_PATCH_CELLS`), facing one of them, one period at a time where it brings the most of what
     they miss (up to :data:`PATCH_DEMAND`), each put in its station's sweep after the bearing nearest it;
-    :data:`PATCH_ROUNDS` times. The programme's stares and straight hops are not quite the flight (the law's
-    way in and out of a station, its turns), and a cell left a few per cent short would cost an orbit at the
-    end of a route; a period is half a time unit where the robot stands anyway. The last round's periods
-    are flown again by :func:`model.touch_ups.with_touch_ups`, whose orbits take what is still short.
+    at most :data:`PATCH_ROUNDS` times. The programme's stares and straight hops are not quite the flight
+    (the law's way in and out of a station, its turns), and a cell left a few per cent short would cost an
+    orbit at the end of a route; a period is half a time unit where the robot stands anyway. Returns the
+    stops and the flight of the routes with them (``simulate_routes``' result), which
+    :func:`model.touch_ups.with_touch_ups` reads for the orbits over what is still short.
     Measured (the 200 x 50 strip, N = 1, seed 0, before whole periods): 8 single cells foretold short, an
     orbit trip of 343 time units."""
     for _ in range(PATCH_ROUNDS):
-        lack, _, _ = simulate_routes(scenario, routes, positions, lookahead, stops=stops)
-        if not (lack > 0.0).any():
-            break
-        stops = _patched(scenario, routes, stops, lack)
-    return stops
+        flown = simulate_routes(scenario, routes, positions, lookahead, stops=stops)
+        if not (flown[0] > 0.0).any():
+            return stops, flown
+        stops = _patched(scenario, routes, stops, flown[0])
+    return stops, simulate_routes(scenario, routes, positions, lookahead, stops=stops)
 
 
 def _patched(

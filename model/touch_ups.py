@@ -151,6 +151,7 @@ def with_touch_ups(
     lookahead: float,
     spacing: float,
     stops: list[list[Stop]] | None = None,
+    flown: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> tuple[list[np.ndarray], list[list[TouchUp]]]:
     """``routes`` with an orbit (:func:`orbit_for`) for every group of cells they will leave short
     (:func:`simulate_routes`, grouped as :func:`blob_labels` does), and each robot's :class:`TouchUp`
@@ -158,8 +159,10 @@ def with_touch_ups(
     robot's foretold flight time, the way to the orbit at k_v, its turns at the time one turn takes) is
     taken, as a greedy schedule would; the orbit is appended to the robot's route. A team of one also
     weighs going out to the orbit from its route's nearest point and back (:func:`_cheapest`), unless its
-    route has ``stops`` (:mod:`model.stations`), whose places along it an orbit put inside would move."""
-    lack, coverage, finish = simulate_routes(scenario, routes, positions, lookahead, stops=stops)
+    route has ``stops`` (:mod:`model.stations`), whose places along it an orbit put inside would move.
+    ``flown``: :func:`simulate_routes`' result for these routes and stops, where the caller has it already
+    (:func:`model.stations.with_patched_stops`); the routes are flown here otherwise."""
+    lack, coverage, finish = flown or simulate_routes(scenario, routes, positions, lookahead, stops=stops)
     count, labels = blob_labels(lack > 0.0, scenario.cell, spacing)
     spots = [labels == k for k in range(1, count) if (labels == k).any()]
     touch_ups: list[list[TouchUp]] = [[] for _ in routes]

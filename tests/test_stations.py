@@ -84,13 +84,14 @@ def test_station_routes_share_out_every_period_and_cover_the_domain(agents):
     assert shared in expected  # a cut inside a station's periods gives each side whole periods, none twice
     lack, _, _ = simulate_routes(scenario, routes, positions, LOOKAHEAD, stops=stops)
     assert (lack > 0.0).mean() < 0.03  # the programme's stares and hops, flown by the law, leave a little
-    patched = with_patched_stops(scenario, routes, stops, positions, LOOKAHEAD)
+    patched, flown = with_patched_stops(scenario, routes, stops, positions, LOOKAHEAD)
     added = sum(len(stop.bearings) for robot in patched for stop in robot) - shared
     assert added < 0.05 * shared
     assert (added > 0) == bool((lack > 0.0).any())
     assert [[stop.at for stop in robot] for robot in patched] == [[stop.at for stop in robot] for robot in stops]
-    lack, _, _ = simulate_routes(scenario, routes, positions, LOOKAHEAD, stops=patched)
-    assert not (lack > 0.0).any()  # the periods put in where the flight fell short finish it
+    again = simulate_routes(scenario, routes, positions, LOOKAHEAD, stops=patched)
+    assert not (again[0] > 0.0).any()  # the periods put in where the flight fell short finish it
+    assert all(np.array_equal(a, b) for a, b in zip(flown, again, strict=True))  # the flight returned is theirs
 
 
 def test_whole_periods_cover_every_cell_with_fewer_periods_than_rounding_up():
