@@ -13,15 +13,17 @@ import numpy as np
 
 from agents.radio import RadioLink
 from agents.robot import Robot, SimulatedUnicycle
-from model.coverage_map import load_kernels as load_map_kernels
-from model.exact_coverage import load_kernels as load_event_kernel
-from model.ground import NO_FIELD
-from model.parameters import law_parameters, safety_parameters, starting_poses
-from model.safety import MEMORY_SIZE, PARKED, POSE_STALE, RAN_LATE, TEAMMATE, filter_command
-from model.safety import load_kernels as load_safety_kernels
+from model.controllers import controller_of, law_parameters
+from model.controllers.plugin_step import decide_with
+from model.paper.coverage_map import load_kernels as load_map_kernels
+from model.parameters import safety_parameters, starting_poses
+from model.radio.exact_coverage import load_kernels as load_event_kernel
+from model.safety.safety import MEMORY_SIZE, PARKED, POSE_STALE, RAN_LATE, TEAMMATE, filter_command
+from model.safety.safety import load_kernels as load_safety_kernels
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, load_kernels, no_look
-from model.world import world_of
+from model.world.ground import NO_FIELD
+from model.world.world import world_of
 from protocol.events import as_event
 from protocol.inbox import Inbox, Membership, Received
 from protocol.keys import TeamKeys
@@ -54,6 +56,7 @@ class AgentNode:
         self.keys = TeamKeys(options.team)
         self.limits = Limits.of(scenario)
         self.replica = MapReplica.of(scenario)
+        self.controller = controller_of(scenario)
         self.law: LawParameters = law_parameters(scenario, self.replica.map)
         self.world = world_of(scenario)
         self.ground = self.world.ground
@@ -65,8 +68,8 @@ class AgentNode:
         self.heard_at = np.full(scenario.agents, time.monotonic())
         self.kinds = np.full(scenario.agents, TEAMMATE, dtype=np.int64)  # PARKED once a teammate's process is gone
         self.safety = safety_parameters(scenario)
-        self.safety_memory = np.zeros(MEMORY_SIZE, dtype=np.int64)  # the filter's deadlock state (model.safety)
-        self.look = no_look()  # the cell the law looked at in the step before (model.wall_law.cell_to_look_at)
+        self.safety_memory = np.zeros(MEMORY_SIZE, dtype=np.int64)  # the filter's deadlock state (model.safety.safety)
+        self.look = no_look()  # the cell the law looked at in the step before (model.world.wall_law.cell_to_look_at)
         self.robot = robot or SimulatedUnicycle(tuple(starts[options.agent]), self.law, self.ground)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=1000 + options.agent)
         self.step = 0
@@ -261,18 +264,17 @@ class AgentNode:
             self.plan_locally(self.radio.in_contact(), pose)
         assert self.objective is not None
         self.positions[me] = pose[:2]
-        field = self.world.field(*self.objective) if self.ground.walls else NO_FIELD
-        v, omega, e_omega, row0, col0, ticks = decide_and_sense(
-            self.replica.map.coverage,
-            *pose,
-            *self.objective,
-            self.law,
-            self.ground,
-            field,
-            self.positions,
-            me,
-            self.look,
-        )
+        if self.controller.compiled:
+            field = self.world.field(*self.objective) if self.ground.walls else NO_FIELD
+            v, omega, e_omega, row0, col0, ticks = decide_and_sense(
+                self.replica.map.coverage, *pose, *self.objective, self.law, self.ground, field, self.positions, me,
+                self.look,
+            )  # fmt: skip
+        else:  # a controller written in Python: the engine's call (anicov.plugin_engine), so lockstep equals it
+            v, omega, e_omega, row0, col0, ticks = decide_with(
+                self.controller, self.scenario, self.step, self.replica.map.coverage, pose, self.objective, self.law,
+                self.ground, self.positions, me,
+            )  # fmt: skip
         flags = 0
         if self.safety.enabled and late:
             v, omega, flags = 0.0, 0.0, RAN_LATE

@@ -1,4 +1,4 @@
-"""One robot's side of a limited radio (issue 13, :mod:`model.radio` for the rule): whom it hears, who is
+"""One robot's side of a limited radio (issue 13, :mod:`model.radio.radio` for the rule): whom it hears, who is
 in contact, and local planning. The agent node owns one :class:`RadioLink`; no Zenoh here."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import time
 
 import numpy as np
 
-from model.planning import Planner
+from model.controllers import controller_of
 from model.scenario import Scenario
 from protocol.messages import AgentState, Pose
 from protocol.recovery import HISTORY_STEPS, RELAY_STEPS
@@ -27,7 +27,7 @@ class RadioLink:
         self.me = me
         self.heard_live = np.full(scenario.agents, -np.inf)  # when each teammate was last heard (monotonic)
         self.out_of_range = 0  # teammates' steps the radio did not deliver
-        self.planner = Planner(scenario) if scenario.planning == "local" else None
+        self.planner = controller_of(scenario).planner(scenario) if scenario.planning == "local" else None
         self.planned_at = -(10**9)  # local planning: the step of the last plan
         self.complete_since: float | None = None  # local planning, realtime: when our replica became complete
 
@@ -65,7 +65,7 @@ class RadioLink:
         self, members: list[int], pose: Pose, positions: np.ndarray, lack: np.ndarray, step: int
     ) -> tuple[float, float]:
         """planning = "local": Algorithms 1-2 on our own replica's Υ (``lack``) for ``members`` and us, at
-        their last known ``positions`` (ours: ``pose``); our own objective (model.radio, local planning)."""
+        their last known ``positions`` (ours: ``pose``); our own objective (model.radio.radio, local planning)."""
         assert self.planner is not None
         members = sorted(set(members) | {self.me})
         where = np.array([pose[:2] if agent == self.me else positions[agent] for agent in members])

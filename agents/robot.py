@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from model.ground import Ground
 from model.step import LawParameters, move
+from model.world.ground import Ground
 from protocol.messages import Pose
 
 

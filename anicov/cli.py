@@ -130,7 +130,7 @@ def command_sweep_plot(args: argparse.Namespace) -> int:
 def command_controller_table(args: argparse.Namespace) -> int:
     from anicov.controller_table import controller_table
 
-    table = controller_table(Path(args.out))
+    table = controller_table(Path(args.out), args.challenger)
     if args.write:
         Path(args.write).write_text(table)
     print(table, end="")
@@ -263,6 +263,12 @@ def _add_sweep(commands: argparse._SubParsersAction) -> None:
     )
     table.add_argument("out", help="the sweep's output directory (sweeps/controllers.toml)")
     table.add_argument("--write", help="also write the Markdown table to this file")
+    table.add_argument(
+        "--challenger",
+        default="anicov",
+        help="the controller whose goals the table checks (default anicov; a plug-in by its column's name, "
+        "e.g. mine.py:Mine)",
+    )
     table.set_defaults(handler=command_controller_table)
 
 
@@ -290,6 +296,11 @@ def _add_bus_tools(commands: argparse._SubParsersAction) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["launch"]:  # every flag is launch_team.py's, --help too (argparse's REMAINDER drops it)
+        from anicov.launch import main as launch_main
+
+        return launch_main(argv[1:])
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

@@ -23,8 +23,15 @@ def read_runs(out_dir: Path) -> dict[tuple[int, str], list[dict[str, str]]]:
     groups: dict[tuple[int, str], list[dict[str, str]]] = defaultdict(list)
     with open(out_dir / "runs.csv", newline="") as file:
         for row in csv.DictReader(file):
-            groups[(int(row["agents"]), row["controller"])].append(row)
+            groups[(int(row["agents"]), controller_label(row["controller"]))].append(row)
     return groups
+
+
+def controller_label(name: str) -> str:
+    """A controller's name as the table heads its columns: a plug-in's file by its own name
+    (``/abs/path/mine.py:Mine`` → ``mine.py:Mine``), every other name as it is."""
+    module, _, attribute = name.rpartition(":")
+    return f"{Path(module).name}:{attribute}" if module.endswith(".py") else name
 
 
 def _mean(values: list[float]) -> float:

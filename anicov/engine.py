@@ -13,24 +13,26 @@ The run ends when no cell is left uncovered (or at ``max_time``).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 from numba import njit
 from numba.typed import List
 
+from anicov.plugin_engine import advance_plugin_team
 from anicov.radio_engine import run_ranged
 from anicov.run_parts import finish_run, objective_fields
-from model.coverage_map import CoverageMap, add_window
-from model.ground import Ground, open_ground
-from model.parameters import coverage_map_of, law_parameters, safety_parameters, starting_poses
-from model.planning import Plan, planner_for
+from model.controllers import controller_of, law_parameters
+from model.controllers.interface import Pilot
+from model.paper.coverage_map import CoverageMap, add_window
+from model.parameters import coverage_map_of, safety_parameters, starting_poses
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack, snapshot_steps
-from model.safety import MEMORY_SIZE, SafetyParameters, filter_command
+from model.safety.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move, sense_only
-from model.world import world_of
-from model.zigzag import boustrophedon_pilots, zigzag_pilots
+from model.world.ground import Ground, open_ground
+from model.world.world import world_of
 
 
 @njit(cache=True)
@@ -44,6 +46,7 @@ def advance_team(
     safety: SafetyParameters,
     memory: np.ndarray,
     looks: np.ndarray,
+    first_step: int,
     steps: int,
     uncovered: int,
     deficit: int,
@@ -52,10 +55,8 @@ def advance_team(
     errors: np.ndarray,
     flags: np.ndarray,
 ) -> tuple[int, int, int]:
-    """Run up to ``steps`` steps of the paper's law for the whole team; stop early at full coverage.
-
-    ``fields[i]``: the distance field of agent i's objective (terrain only). With ``safety`` enabled every
-    command passes through the filter (model.safety), from the poses at t_k, with ``memory`` (N, MEMORY_SIZE) its
+    """Up to ``steps`` steps of a compiled law for the whole team, stopping at full coverage. ``fields[i]``: the distance field of agent i's objective (terrain only). With ``safety`` enabled every
+    command passes through the filter (model.safety.safety), from the poses at t_k, with ``memory`` (N, MEMORY_SIZE) its
     deadlock state; ``looks`` (N, 2): what each robot looked at in the step before, kept between calls too.
     Writes the per-step trace (TRACE_FIELDS), the filter's flags and e_D; returns (steps done, uncovered, deficit).
     """
@@ -105,15 +106,16 @@ def run_scenario(
     """Run one team to full coverage or ``max_time`` in this process."""
     coverage_map = coverage_map_of(scenario)
     poses = starting_poses(scenario) if poses is None else np.array(poses, dtype=np.float64)
-    if scenario.controller in ("zigzag", "boustrophedon"):
-        return _run_zigzag(scenario, coverage_map, poses, record_trace, progress)
+    controller = controller_of(scenario)
+    if (pilots := controller.pilots(scenario, poses)) is not None:
+        return _run_pilots(scenario, coverage_map, poses, pilots, record_trace, progress)
     if math.isfinite(scenario.comm_range) or scenario.planning == "local":
         return run_ranged(scenario, coverage_map, poses, record_trace, progress)
     law, world = law_parameters(scenario, coverage_map), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     looks = np.full((scenario.agents, 2), np.nan)  # nothing looked at yet (model.step.no_look)
-    planner = planner_for(scenario)
-    block = scenario.plan_steps
+    planner, block = controller.planner(scenario), controller.plan_steps(scenario)
+    advance = advance_team if controller.compiled else functools.partial(advance_plugin_team, controller, scenario)
     agents = scenario.agents
     traces: list[np.ndarray] = []
     errors: list[np.ndarray] = [np.array([coverage_map.domain_error()])]
@@ -121,9 +123,7 @@ def run_scenario(
     scratch_trace = np.zeros((block, agents, len(TRACE_FIELDS)))
     scratch_errors = np.zeros(block)
     scratch_flags = np.zeros((block, agents), dtype=np.uint8)
-    flags: list[np.ndarray] = []
-    steps_done = 0
-    plans: list[Plan] = []
+    flags, plans, steps_done = [], [], 0
     next_snapshot = SNAPSHOT_PERIOD
     while steps_done < scenario.max_steps and not coverage_map.complete:
         lack = coverage_map.lack_of_coverage()
@@ -131,9 +131,9 @@ def run_scenario(
         if record_trace:
             plans.append(planner.record(steps_done, objectives))
         steps = min(block, scenario.max_steps - steps_done)
-        done, coverage_map.uncovered_cells, coverage_map.deficit_ticks = advance_team(
+        done, coverage_map.uncovered_cells, coverage_map.deficit_ticks = advance(
             coverage_map.coverage, poses, objectives, law, world.ground, objective_fields(world, objectives),
-            safety, memory, looks, steps, coverage_map.uncovered_cells, coverage_map.deficit_ticks,
+            safety, memory, looks, steps_done, steps, coverage_map.uncovered_cells, coverage_map.deficit_ticks,
             coverage_map.target_ticks * coverage_map.counted_cells, scratch_trace, scratch_errors, scratch_flags,
         )  # fmt: skip
         flags.append(scratch_flags[:done].copy())
@@ -158,19 +158,18 @@ def run_scenario(
     return result
 
 
-def _run_zigzag(
+def _run_pilots(
     scenario: Scenario,
     coverage_map: CoverageMap,
     poses: np.ndarray,
+    pilots: list[Pilot],
     record_trace: bool,
     progress: ProgressCallback | None,
 ) -> RunResult:
-    """The zig-zag baseline: each agent flies its lanes; the run lasts until every plan is done."""
+    """Paths planned once for the team (the zig-zags): each agent flies its own; the run lasts until every
+    pilot is done."""
     law = law_parameters(scenario, coverage_map)
     ground, nobody = open_ground(), np.zeros((0, 2))
-    pilots = (
-        boustrophedon_pilots(scenario, poses) if scenario.controller == "boustrophedon" else zigzag_pilots(scenario)
-    )
     rows_out: list[np.ndarray] = []
     errors = [coverage_map.domain_error()]
     snapshot_times, snapshots = [0.0], [quantised_lack(coverage_map.lack_of_coverage())]

@@ -171,12 +171,13 @@ def wait_for_exit(children: list[Child], timeout: float) -> None:
 
 def warm_numba_cache(scenario: Scenario) -> None:
     """Compile (or load) the jitted kernels once here, so N children do not all compile at once."""
-    from model.coverage_map import load_kernels as load_map_kernels
-    from model.exact_coverage import load_kernels as load_event_kernel
-    from model.parameters import coverage_map_of, exact_kernel_of, law_parameters, safety_parameters, starting_poses
-    from model.safety import load_kernels as load_safety_kernels
+    from model.controllers import law_parameters
+    from model.paper.coverage_map import load_kernels as load_map_kernels
+    from model.parameters import coverage_map_of, exact_kernel_of, safety_parameters, starting_poses
+    from model.radio.exact_coverage import load_kernels as load_event_kernel
+    from model.safety.safety import load_kernels as load_safety_kernels
     from model.step import load_kernels
-    from model.world import world_of
+    from model.world.world import world_of
 
     grid, ground = coverage_map_of(scenario), world_of(scenario).ground
     load_kernels(grid.coverage, tuple(starting_poses(scenario)[0]), law_parameters(scenario, grid), ground)
@@ -252,6 +253,7 @@ def main(argv: list[str] | None = None) -> int:
         router.declare_subscriber(keys.control, watch.on_sample)
         router.declare_subscriber(keys.status, watch.on_sample)
         coordinator_command = start_team(args, scenario.agents, out_dir, children)
+        seen = Supervision()
         try:
             if args.no_coordinator:  # local planning: the robots start, plan and end the run themselves
                 agent_children = [child for child in children if child.role.startswith("agent-")]
@@ -264,6 +266,8 @@ def main(argv: list[str] | None = None) -> int:
             if not stop.stopped:
                 # After the end of the run every child leaves by itself (the logger flushes first).
                 wait_for_exit(children, GRACE_SECONDS)
+                if not args.no_coordinator:
+                    note_failed_agents(children, seen)
             stop_children(children)
             stop_children(bases)
     if stop.stopped:
@@ -375,6 +379,16 @@ def supervise(
     return seen
 
 
+def note_failed_agents(children: list[Child], seen: Supervision) -> None:
+    """Agents that left the run failing and were not seen go (one that failed as the run ended, after the
+    last look of :func:`supervise`): reported as lost, never silently."""
+    for child in children:
+        code = child.process.poll()
+        if child.role.startswith("agent-") and code not in (None, 0) and child.role not in seen.lost:
+            log.warning("%s exited with %s during the run (see %s)", child.role, code, child.log_path)
+            seen.lost.append(child.role)
+
+
 def report_without_coordinator(
     args: argparse.Namespace,
     agents: int,
@@ -449,7 +463,7 @@ def report(
             + f", logs in {logs}"
         )
         if seen.lost:
-            print(f"  lost on the way {', '.join(seen.lost)} (the team completed without them)")
+            print(f"  lost on the way {', '.join(seen.lost)} (the team went on without them)")
         if seen.restarts:
             print(
                 f"  coordinator     killed and restarted {seen.restarts} time(s); it resumed from the agents' histories"

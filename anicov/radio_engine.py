@@ -1,7 +1,7 @@
 """The in-process engine for a team on a radio (issue 13): one replica per robot.
 
 The same step as :mod:`anicov.engine` (decide, sense, move with the same kernels), but each robot
-decides from its *own* replica of Λ, and what reaches that replica follows :mod:`model.radio`: a robot
+decides from its *own* replica of Λ, and what reaches that replica follows :mod:`model.radio.radio`: a robot
 holds its own events at once and its teammates' through contact and anti-entropy. The run ends when the
 world is covered (the union of every event made), whatever each replica believes. Planning is central
 (the coordinator, a base station everyone hears, plans on the union) or local (each robot on its
@@ -18,15 +18,16 @@ import copy
 import numpy as np
 
 from anicov.run_parts import finish_run, objective_fields
-from model.coverage_map import CoverageMap
-from model.parameters import law_parameters, safety_parameters
-from model.planning import Plan, TeamPlanner, planner_for
-from model.radio import contacts, divergence, local_members, merge_knowledge
+from model.controllers import controller_of, law_parameters
+from model.paper.coverage_map import CoverageMap
+from model.parameters import safety_parameters
+from model.planning import Plan, TeamPlanner
+from model.radio.radio import contacts, divergence, local_members, merge_knowledge
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack
-from model.safety import MEMORY_SIZE, SafetyParameters, filter_command
+from model.safety.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move
-from model.world import World, world_of
+from model.world.world import World, world_of
 
 Window = tuple[int, int, np.ndarray]
 
@@ -37,7 +38,7 @@ class RadioTeam:
     def __init__(self, union: CoverageMap, agents: int) -> None:
         self.union = union  # every event made: the world's coverage
         self.replicas = [copy.deepcopy(union) for _ in range(agents)]
-        self.knows = np.zeros((agents, agents), dtype=np.int64)  # model.radio: events of j held by i
+        self.knows = np.zeros((agents, agents), dtype=np.int64)  # model.radio.radio: events of j held by i
         self.events: list[list[Window]] = [[] for _ in range(agents)]
         self.divergence_sum = 0.0
         self.divergence_max = 0
@@ -46,7 +47,7 @@ class RadioTeam:
 
     def exchange(self, windows: list[Window], in_contact: np.ndarray) -> None:
         """Step k's events enter the union and their makers' replicas; contact and anti-entropy bring
-        the rest (:func:`model.radio.merge_knowledge`)."""
+        the rest (:func:`model.radio.radio.merge_knowledge`)."""
         for agent, window in enumerate(windows):
             self.events[agent].append(window)
             self.union.add(*window)
@@ -67,7 +68,7 @@ class RadioTeam:
 
     def figures(self) -> dict[str, float]:
         """What summary.json reports of the radio: replica divergence (cells whose Υ differs from the
-        union's, :func:`model.radio.divergence`: mean over robots then over the run's steps; the most any
+        union's, :func:`model.radio.radio.divergence`: mean over robots then over the run's steps; the most any
         robot had at any step; the mean at the end, before the final exchange leaves one map everywhere),
         and how many teammates a robot heard, on average over robots and steps."""
         steps = max(self.steps, 1)
@@ -95,8 +96,9 @@ def run_ranged(
     looks = np.full((scenario.agents, 2), np.nan)  # what each robot looked at in the step before
     agents = scenario.agents
     team = RadioTeam(coverage_map, agents)
-    central = planner_for(scenario)
-    planners = [planner_for(scenario) for _ in range(agents)]
+    controller = controller_of(scenario)
+    central = controller.planner(scenario)
+    planners = [controller.planner(scenario) for _ in range(agents)]
     rows: list[np.ndarray] = []
     flags: list[np.ndarray] = []
     errors = [coverage_map.domain_error()]
@@ -185,7 +187,7 @@ def plan_objectives(
     in_contact: np.ndarray,
 ) -> np.ndarray:
     """(N, 2): central, Algorithms 1-2 on the union for everyone; local, each robot's own objective from
-    its replica and the teammates it hears (:func:`model.radio.local_members`)."""
+    its replica and the teammates it hears (:func:`model.radio.radio.local_members`)."""
     if scenario.planning == "central":
         return central.plan(team.union.lack_of_coverage(), positions)
     objectives = np.zeros((len(positions), 2))

@@ -17,9 +17,9 @@ import numpy as np
 
 from anicov.engine import run_scenario
 from anicov.sweep import Sweep, read_done, run_sweep
-from model.metrics import optimum_time, pass_reach, straight_pass_coverage, total_sensing_ability
+from model.controllers import BUILT_IN
+from model.paper.metrics import optimum_time, pass_reach, straight_pass_coverage, total_sensing_ability
 from model.scenario import PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
-from model.zigzag import zigzag_pilots, zigzag_start_poses
 
 PAPER = {
     "d100": 2.72,
@@ -58,7 +58,7 @@ def paper_curve(agents: int) -> float:
 def zigzag_reference(base: Scenario) -> dict[str, Any]:
     """One agent flying the Fig. 8 plan from its start: time and path to the plan's end."""
     scenario = base.with_overrides(controller="zigzag", agents=1)
-    result = run_scenario(scenario, poses=zigzag_start_poses(scenario), record_trace=True)
+    result = run_scenario(scenario, poses=BUILT_IN["zigzag"].start_poses(scenario), record_trace=True)
     return {
         "result": result,
         "time": result.plan_time,
@@ -211,7 +211,8 @@ def _plot_straight_pass(report: dict[str, Any], base: Scenario, path: Path) -> N
 def _plot_zigzag(report: dict[str, Any], base: Scenario, zigzag_result: Any, path: Path) -> None:
     """Fig. 8: the zig-zag agent's path and waypoints in the domain."""
     fig, ax = _figure((5.5, 4.5))
-    waypoints = zigzag_pilots(base.with_overrides(controller="zigzag", agents=1))[0].waypoints
+    one = base.with_overrides(controller="zigzag", agents=1)
+    waypoints = BUILT_IN["zigzag"]().pilots(one, BUILT_IN["zigzag"].start_poses(one))[0].waypoints
     ax.plot(zigzag_result.trace[:, 0, 0], zigzag_result.trace[:, 0, 1], color="tab:blue", linewidth=0.8)
     ax.plot(waypoints[:, 0], waypoints[:, 1], ".", color="tab:red", markersize=3)
     width, height = base.domain

@@ -7,10 +7,10 @@ import math
 
 import numpy as np
 
-from model.coverage_map import CoverageMap
+from model.paper.coverage_map import CoverageMap
 from model.run import TRACE_FIELDS, RunResult
 from model.scenario import Scenario
-from model.world import World
+from model.world.world import World
 
 
 def objective_fields(world: World, objectives: np.ndarray) -> np.ndarray:

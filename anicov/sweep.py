@@ -109,6 +109,8 @@ def load_sweep(path: Path) -> Sweep:
         raise ScenarioError(f"{path}: grid: 'seed' is given by the top-level key seeds")
     for name, values in grid.items():
         for index, value in enumerate(values):
+            if name == "controller" and isinstance(value, str) and ".py:" in value:
+                value = str(path.parent / value)  # a controller's file, relative to this file as the scenario is
             try:
                 # As the scenario holds it (20 and 20.0 are one range), so a resumed sweep finds its rows.
                 values[index] = _plain(getattr(base.with_overrides(**{name: value}), name, value))

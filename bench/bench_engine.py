@@ -25,14 +25,15 @@ from anicov import engine
 from anicov.engine import advance_team, run_scenario
 from anicov.run_parts import objective_fields
 from bench.machine import describe_machine
-from model.coverage_map import CoverageMap
-from model.parameters import coverage_map_of, initial_poses, law_parameters, safety_parameters, starting_poses
-from model.reachability import nearest_reachable
+from model.controllers import law_parameters
+from model.paper.coverage_map import CoverageMap
+from model.parameters import coverage_map_of, initial_poses, safety_parameters, starting_poses
 from model.reference import numpy_team_step
 from model.run import TRACE_FIELDS
-from model.safety import MEMORY_SIZE
+from model.safety.safety import MEMORY_SIZE
 from model.scenario import PAPER_SCENARIO, load_scenario
-from model.world import world_of
+from model.world.reachability import nearest_reachable
+from model.world.world import world_of
 
 REPEATS = 3
 """Each engine rate is the best of this many timings of the same steps from the same start: this VM's

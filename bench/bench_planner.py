@@ -1,9 +1,9 @@
 """How long the anicov controller's first plan takes, with stations (its default): the stations' layouts
-(model.stations.layout: the linear programme for each spacing and both serpentines, once per process and
+(model.controllers.anicov.stations.layout: the linear programme for each spacing and both serpentines, once per process and
 scenario, timed on its own), then per team the serpentine cut for the robots on its 8 symmetries and the
-order searched on the 2 soonest (model.piece_order), the routes flown until they leave nothing short or
+order searched on the 2 soonest (model.controllers.anicov.piece_order), the routes flown until they leave nothing short or
 twice patched (periods put in where they fall short), the last flight read for the orbits over what is left
-(model.touch_ups). In
+(model.controllers.anicov.touch_ups). In
 realtime the team waits this long for its first carrots; in lockstep and in the engine it is paid once per
 run.
 
@@ -21,10 +21,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.machine import describe_machine
-from model.lane_planner import LanePlanner
+from model.controllers.anicov.lane_planner import LanePlanner
+from model.controllers.anicov.stations import forget_layouts, layout
 from model.parameters import starting_poses
 from model.scenario import load_scenario
-from model.stations import forget_layouts, layout
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 CASES = [

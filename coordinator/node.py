@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from coordinator.run_log import RunLog
-from model.planning import planner_for
+from model.controllers import controller_of
 from model.run import RunResult, snapshot_steps
 from model.scenario import Scenario
 from protocol.inbox import Inbox, Membership, Received
@@ -45,7 +45,7 @@ class Coordinator:
         self.keys = TeamKeys(options.team)
         self.limits = Limits.of(scenario)
         self.replica = MapReplica.of(scenario)
-        self.planner = planner_for(scenario)
+        self.planner = controller_of(scenario).planner(scenario)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=999)
         self.alive: set[int] = set()
         self.members: set[int] = set()

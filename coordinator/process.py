@@ -19,8 +19,8 @@ from coordinator.endpoints import CoordinatorBus
 from coordinator.node import Coordinator, CoordinatorOptions
 from coordinator.startup import gather_team, resume_running_team
 from coordinator.stepping import Stepping
-from model.coverage_map import load_kernels as load_map_kernels
-from model.exact_coverage import load_kernels as load_event_kernel
+from model.paper.coverage_map import load_kernels as load_map_kernels
+from model.radio.exact_coverage import load_kernels as load_event_kernel
 from model.scenario import Scenario
 from protocol.messages import RunControl
 from protocol.recovery import LossTimer

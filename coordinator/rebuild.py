@@ -13,7 +13,6 @@ before the restart left no history: their coverage is adopted from a member's sn
 from __future__ import annotations
 
 from coordinator.node import Coordinator
-from model.lane_planner import LanePlanner
 from protocol.inbox import Received
 from protocol.messages import AgentState, MapDelta, Snapshot
 
@@ -59,15 +58,13 @@ def rebuild(node: Coordinator, messages: HistoryMessages, members: set[int], sna
             node.log.events.append(f"coverage of agents {sorted(gone)} taken from a member's snapshot")
         if node.lockstep:
             node.open_step = resume
-        elif isinstance(node.planner, LanePlanner) and node.planner.routes:
-            # Realtime plans are not replayed (they ran on the wall clock), but the anicov controller's
-            # routes were cut once, at the first plan: cut them again and put each robot on its own.
+        elif node.planner.cut_at_start:
+            # Realtime plans are not replayed (they ran on the wall clock), but routes cut once, at the first
+            # plan (anicov's), are: put each robot back on its own.
             positions = [node.positions[agent] for agent in sorted(publishing)]
-            node.planner.resume(node.replica.map.lack_of_coverage(), positions, sorted(publishing))
-            on_routes = [agent for agent in sorted(publishing) if not node.planner.routes[agent].done()]
-            node.log.events.append(
-                f"anicov routes cut again; agents {on_routes} resume on theirs, the others take passes"
-            )
+            resumed = node.planner.resume(node.replica.map.lack_of_coverage(), positions, sorted(publishing))
+            if resumed:
+                node.log.events.append(resumed)
         # What lies beyond: the open step's deltas (for the next go) and any later ones.
         for message in messages:
             if isinstance(message, MapDelta) and message.seq >= resume and message.agent in members:
@@ -93,7 +90,7 @@ def replay(
             node.positions[state.agent] = (state.pose[0], state.pose[1])
         if node.lockstep and step % node.scenario.plan_steps == 0:
             node.plan(step)
-        elif step == 0 and isinstance(node.planner, LanePlanner):
+        elif step == 0 and node.planner.cut_at_start:
             node.plan(step)  # realtime: the routes as the first plan cut them, from the starting poses
         for state in states.get(step, []):
             node.latest_state_step[state.agent] = step

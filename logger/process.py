@@ -19,7 +19,7 @@ from functools import partial
 import zenoh
 
 from logger.team_logger import LoggerOptions, TeamLogger
-from model.exact_coverage import load_kernels as load_event_kernel
+from model.radio.exact_coverage import load_kernels as load_event_kernel
 from model.scenario import Scenario
 from protocol.agreement import (
     ScenarioMismatch,

@@ -42,11 +42,11 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from model.fixed_point import COVERAGE_SCALE
-from model.safety import DEADLOCK_FOUND, DEADLOCK_RESOLVED
-from model.safety_record import ACTIVE as FILTER_ACTIVE
+from model.paper.fixed_point import COVERAGE_SCALE
+from model.safety.safety import DEADLOCK_FOUND, DEADLOCK_RESOLVED
+from model.safety.safety_record import ACTIVE as FILTER_ACTIVE
 from model.scenario import Scenario
-from model.world import world_of
+from model.world.world import world_of
 
 APPLICATION_ID = "anicov"
 TRAIL_STEPS = 500
@@ -181,7 +181,7 @@ class RunRecorder:
         e_omega: float,
         safety: int = 0,
     ) -> None:
-        """One agent's step (``safety``: the filter's flags, model.safety); buffered and sent in columns
+        """One agent's step (``safety``: the filter's flags, model.safety.safety); buffered and sent in columns
         (cheap), drawn fully on map steps. Deadlocks found and resolved go to the events."""
         self._pending.setdefault(agent, []).append((step, x, y, theta, v, omega, e_omega, safety))
         if safety & DEADLOCK_FOUND:

@@ -9,42 +9,17 @@ import math
 
 import numpy as np
 
-from model.clearance import disk_is_free
-from model.coverage_map import CoverageMap
-from model.exact_coverage import ExactKernel, exact_kernel
-from model.route import face_radius_of
-from model.safety import SafetyParameters, disabled_safety
+from model.paper.coverage_map import CoverageMap
+from model.radio.exact_coverage import ExactKernel, exact_kernel
+from model.safety.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
-from model.scenario_safety import point_speed
-from model.step import LawParameters
-from model.weave import sweep_of
-from model.world import world_of
-
-
-def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParameters:
-    """The control and sensing parameters of a scenario."""
-    sweep = sweep_of(scenario) if scenario.controller == "anicov" and not scenario.stations else None
-    return LawParameters(
-        sensing_range=scenario.range,
-        half_angle=scenario.half_angle,
-        alpha_max=scenario.alpha_max,
-        beta=scenario.beta,
-        k_v=scenario.k_v,
-        k_omega=scenario.k_omega,
-        dt=scenario.dt,
-        cell=scenario.cell,
-        target_ticks=coverage_map.target_ticks,
-        literal_heading=scenario.controller == "paper-literal",
-        literal_omega=scenario.controller in ("paper-literal", "paper-eq16"),
-        pursuit=scenario.controller == "anicov",
-        weave_amplitude=sweep.amplitude if sweep else 0.0,
-        weave_wavelength=sweep.wavelength if sweep else 1.0,
-        face_radius=face_radius_of(scenario),
-    )
+from model.scenario.safety_keys import point_speed
+from model.world.clearance import disk_is_free
+from model.world.world import world_of
 
 
 def exact_kernel_of(scenario: Scenario) -> ExactKernel | None:
-    """The integer coverage kernel of a scenario's sensor and grid (model.exact_coverage), or None where
+    """The integer coverage kernel of a scenario's sensor and grid (model.radio.exact_coverage), or None where
     its numbers do not fit (a domain or range over 2²⁰ units): deltas then travel as cells."""
     try:
         return exact_kernel(
@@ -55,7 +30,7 @@ def exact_kernel_of(scenario: Scenario) -> ExactKernel | None:
 
 
 def coverage_map_of(scenario: Scenario) -> CoverageMap:
-    """A fresh map of the scenario's grid, started as its world says (:meth:`model.world.World.head_start`:
+    """A fresh map of the scenario's grid, started as its world says (:meth:`model.world.world.World.head_start`:
     cells nobody can cover are out of e_D; a priority map's cells start part-way)."""
     rows, cols = scenario.grid_shape
     coverage_map = CoverageMap(rows, cols, scenario.cell, scenario.lambda_star)
@@ -155,7 +130,9 @@ def starting_poses(scenario: Scenario) -> np.ndarray:
     if world.open:
         return initial_poses(scenario)
     clearance = spacing = START_CLEARANCE * scenario.cell
-    if scenario.filters:  # every barrier holds at t_0 (model.safety): points 2r + s + 2l apart, disks s off walls
+    if (
+        scenario.filters
+    ):  # every barrier holds at t_0 (model.safety.safety): points 2r + s + 2l apart, disks s off walls
         clearance = max(clearance, scenario.safety_margin)
         spacing = max(spacing, scenario.safety_margin + 4.0 * scenario.lookahead)
     return free_initial_poses(
@@ -172,7 +149,7 @@ def starting_poses(scenario: Scenario) -> np.ndarray:
 
 
 def safety_parameters(scenario: Scenario) -> SafetyParameters:
-    """The safety filter's constants (model.safety); disabled for point robots or ``safety = false``."""
+    """The safety filter's constants (model.safety.safety); disabled for point robots or ``safety = false``."""
     if not scenario.filters:
         return disabled_safety()
     omega_max = math.pi * scenario.k_omega

@@ -1,65 +1,43 @@
-"""The team's planning step: Algorithm 1 (objectives from blobs) then Algorithm 2 (assignment).
+"""What every team planner shares: the plan as the recording keeps it, the interface the engine and the
+coordinator call, and eq. 17's distances on a terrain (the lengths of the shortest free paths).
 
-The in-process engine and the coordinator process call the same :class:`Planner`, so the objectives of a run do not depend on where the planning runs.
+Each controller's planner lives with its controller (:mod:`model.controllers`); the in-process engine and the
+coordinator process call the same one, so the objectives of a run do not depend on where the planning runs.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
-from model.assignment import assign_objectives
-from model.geodesic import path_length
-from model.lane_planner import LanePlanner
-from model.objectives import BlobObjectives, fallback_objective, select_objectives
-from model.reachability import nearest_reachable
-from model.scenario import Scenario
-from model.world import World, world_of
+from model.world.geodesic import path_length
+from model.world.world import World
 
 Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
 """(step, members, targets (N, 2), blob objectives Ψ (M, 2), blob labels of the grid or None)."""
 
 
-@dataclass
-class Planner:
-    """Algorithm 1 then Algorithm 2, with the blob objectives kept between calls (Alg. 1 reuses them)."""
+class TeamPlanner:
+    """The team's planning: ``plan`` gives every member (by id; default all, in id order) its objective
+    (x, y), shape (N, 2); ``labels`` and ``record`` are what the recording keeps of the last plan."""
 
-    scenario: Scenario
-    blobs: BlobObjectives = field(default_factory=BlobObjectives)
+    cut_at_start = False
+    """True when the first plan fixes each robot's whole route from the starting poses: a coordinator
+    rebuilt in realtime plans step 0 again from those poses, then :meth:`resume`s."""
 
     def plan(self, lack: np.ndarray, positions: np.ndarray, members: list[int] | None = None) -> np.ndarray:
-        """Objective (x, y) for every agent (``members``, by id; default all, in id order), shape (N, 2).
-
-        A scenario with fixed ``objectives`` gives each robot its own, Algorithms 1–2 do not run.
-
-        On a terrain Algorithm 1 runs on the same Υ (cells nobody can cover are at Λ* already), each
-        objective is then moved into the team's space (:func:`model.reachability.nearest_reachable`)
-        and Algorithm 2 takes the lengths of the shortest free paths to them (:func:`path_lengths`)."""
-        if self.scenario.objectives:
-            ids = range(len(positions)) if members is None else members
-            return np.array([self.scenario.objectives[agent] for agent in ids], dtype=np.float64).reshape(-1, 2)
-        world = world_of(self.scenario)
-        terrain = bool(world.ground.walls)
-        self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range, by_paths=terrain)
-        objectives = self.blobs.positions
-        if len(objectives) == 0:
-            fallback = fallback_objective(lack, positions, self.scenario.cell)
-            if fallback is None:
-                return positions.copy()
-            objectives = fallback[None, :]
-        if not terrain:
-            return objectives[assign_objectives(positions, objectives)]
-        objectives = nearest_reachable(world.reachable, objectives, self.scenario.cell)
-        return objectives[assign_objectives(positions, objectives, path_lengths(world, positions, objectives))]
+        raise NotImplementedError
 
     def labels(self) -> np.ndarray | None:
         """The blob labels of the last plan, as the recording keeps them (uint16), or None."""
-        return None if self.blobs.labels is None else self.blobs.labels.astype(np.uint16)
+        return None
 
     def record(self, step: int, targets: np.ndarray) -> Plan:
         """This plan as kept for the recording: members are all agents, in id order."""
-        return (step, tuple(range(len(targets))), targets.copy(), self.blobs.positions.copy(), self.labels())
+        return (step, tuple(range(len(targets))), targets.copy(), np.zeros((0, 2)), self.labels())
+
+    def resume(self, lack: np.ndarray, positions: list[tuple[float, float]], members: list[int]) -> str | None:
+        """Put each member back on its plan after a restart (realtime); what was done, for the run log."""
+        return None
 
 
 def path_lengths(world: World, positions: np.ndarray, objectives: np.ndarray) -> np.ndarray:
@@ -75,14 +53,3 @@ def path_lengths(world: World, positions: np.ndarray, objectives: np.ndarray) ->
                 field, ground.occupied, x, y, goal_x, goal_y, cell, ground.plan_radius, ground.bounded, lengths[i, j]
             )
     return lengths
-
-
-TeamPlanner = Planner | LanePlanner
-"""Either planning; both answer plan(lack, positions, members), labels() and record(step, targets)."""
-
-
-def planner_for(scenario: Scenario) -> TeamPlanner:
-    """The planning of a scenario's controller: Algorithms 1-2, or the anicov controller's lanes."""
-    if scenario.controller == "anicov":
-        return LanePlanner(scenario)
-    return Planner(scenario)

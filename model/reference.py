@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from model.control import combined_law, global_law, local_law
-from model.dynamics import unicycle_step
-from model.fixed_point import COVERAGE_SCALE
+from model.paper.control import combined_law, global_law, local_law
+from model.paper.dynamics import unicycle_step
+from model.paper.fixed_point import COVERAGE_SCALE
 from model.step import LawParameters
 
 

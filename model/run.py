@@ -49,7 +49,7 @@ class RunResult:
     final_lack: np.ndarray
     plan_time: float | None = None  # zig-zag only: when the last lane was finished
     plans: list[Plan] = field(default_factory=list)  # every replan, for the recording
-    safety_flags: np.ndarray | None = None  # (steps, N) uint8: what the safety filter did (model.safety)
+    safety_flags: np.ndarray | None = None  # (steps, N) uint8: what the safety filter did (model.safety.safety)
     radio: dict[str, float] | None = None  # a team on a limited radio (anicov.radio_engine.RadioTeam.figures)
     timed_positions: dict[int, np.ndarray] | None = None  # realtime: agent → (M, 3) wall time, x, y after each step
 

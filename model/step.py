@@ -11,13 +11,13 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from model.clearance import disk_is_free, step_or_stay
-from model.control import combined_law, global_law, local_law, pursuit_law
-from model.dynamics import unicycle_step
-from model.ground import Ground
-from model.occlusion import teammates_in_view
-from model.sensing import sense_wedge_among
-from model.wall_law import global_law_among_walls
+from model.paper.control import combined_law, global_law, local_law, pursuit_law
+from model.paper.dynamics import unicycle_step
+from model.world.clearance import disk_is_free, step_or_stay
+from model.world.ground import Ground
+from model.world.occlusion import teammates_in_view
+from model.world.wall_law import global_law_among_walls
+from model.world.wedge import sense_wedge_among
 
 
 class LawParameters(NamedTuple):
@@ -34,8 +34,8 @@ class LawParameters(NamedTuple):
     target_ticks: int  # Λ* in fixed-point ticks
     literal_heading: bool  # eq. 11 as printed
     literal_omega: bool  # eq. 16 as printed
-    pursuit: bool = False  # the anicov controller: pure pursuit of a carrot (model.control.pursuit_law)
-    weave_amplitude: float = 0.0  # the anicov controller's weave, radians (model.weave; 0: straight)
+    pursuit: bool = False  # the anicov controller: pure pursuit of a carrot (model.paper.control.pursuit_law)
+    weave_amplitude: float = 0.0  # the anicov controller's weave, radians (model.controllers.anicov.weave; 0: straight)
     weave_wavelength: float = 1.0  # its wavelength, units
     face_radius: float = 0.0  # the anicov controller's stations: a carrot this near is a bearing to face (0: none)
 
@@ -50,8 +50,8 @@ def read_wedge(
     ground: Ground,
     teammates: np.ndarray,
 ) -> tuple[float, float, float, int, int, np.ndarray]:
-    """:func:`model.sensing.sense_wedge` with the law's sensor, ``teammates`` those that may hide part of
-    the wedge (:func:`model.occlusion.teammates_in_view`)."""
+    """:func:`model.world.wedge.sense_wedge` with the law's sensor, ``teammates`` those that may hide part of
+    the wedge (:func:`model.world.occlusion.teammates_in_view`)."""
     return sense_wedge_among(
         coverage,
         law.target_ticks,
@@ -77,7 +77,7 @@ def no_look() -> np.ndarray:
 def pursue(
     x: float, y: float, theta: float, objective_x: float, objective_y: float, law: LawParameters
 ) -> tuple[float, float]:
-    """(v, ω) of the anicov controller's law (:func:`model.control.pursuit_law`) toward ``objective``, with
+    """(v, ω) of the anicov controller's law (:func:`model.paper.control.pursuit_law`) toward ``objective``, with
     ``law``'s gains, time step and weave."""
     return pursuit_law(
         x, y, theta, objective_x, objective_y, law.k_v, law.k_omega, law.dt, law.weave_amplitude,
@@ -105,7 +105,7 @@ def decide_and_sense(
     On a terrain: ``field`` is the geodesic distance field of the objective (the global law follows the
     shortest free path when a wall hides it), ``positions`` (N, 2) every robot's position with this
     one's at row ``me`` (teammates hide cells), ``look`` (2,) the cell this robot looked at in the step before
-    (:func:`model.wall_law.cell_to_look_at`; NaN: none; the law writes it); in the open world none is read."""
+    (:func:`model.world.wall_law.cell_to_look_at`; NaN: none; the law writes it); in the open world none is read."""
     teammates = teammates_in_view(ground, positions, me, x, y, law.sensing_range)
     e_omega, w_left, w_right, row0, col0, ticks = read_wedge(coverage, x, y, theta, law, ground, teammates)
     if law.pursuit:
@@ -183,7 +183,7 @@ def move(
     x: float, y: float, theta: float, v: float, omega: float, law: LawParameters, ground: Ground
 ) -> tuple[float, float, float]:
     """The pose after one step, eq. 1; on a terrain a step that would put the disk over a wall (or off
-    the map) is not taken as a move, only as a turn (:func:`model.clearance.step_or_stay`)."""
+    the map) is not taken as a move, only as a turn (:func:`model.world.clearance.step_or_stay`)."""
     if ground.walls or ground.bounded:
         return step_or_stay(ground.occupied, x, y, theta, v, omega, law.dt, ground.radius, law.cell, ground.bounded)
     return unicycle_step(x, y, theta, v, omega, law.dt)

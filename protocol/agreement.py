@@ -16,7 +16,7 @@ import logging
 import zenoh
 
 from model.scenario import Scenario
-from model.world import world_of
+from model.world.world import world_of
 from protocol.decoding import decode
 from protocol.keys import TeamKeys, agent_of_key
 from protocol.messages import Limits, ProtocolError, ScenarioDigest, encode

@@ -16,7 +16,7 @@ from typing import Any
 import msgpack
 import numpy as np
 
-from model.exact_coverage import event_window
+from model.radio.exact_coverage import event_window
 from protocol.events import delta_of_event
 from protocol.messages import (
     COMPACT_COUNT,

@@ -3,9 +3,9 @@ the cells itself, instead of the cells.
 
 The rule, for a delta of agent a at step k sensed from pose (x, y, θ):
 
-1. Every replica computes the ticks with the integer kernel (:func:`model.exact_coverage.event_ticks`):
+1. Every replica computes the ticks with the integer kernel (:func:`model.radio.exact_coverage.event_ticks`):
    the same integers on every CPU, from the pose's three float64 numbers and the scenario.
-2. The sender computed its own ticks with the model's float kernel (:mod:`model.sensing`), which may
+2. The sender computed its own ticks with the model's float kernel (:mod:`model.world.wedge`), which may
    round a cell the other way (a few cells per hundred thousand) and, on a terrain, leaves out cells a
    wall or a teammate hides. It lists every cell where the two differ, as (flat index in the kernel's
    window, its ticks); replicas write those over the kernel's. So every replica applies exactly the
@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from model.exact_coverage import ExactKernel, event_ticks
+from model.radio.exact_coverage import ExactKernel, event_ticks
 from protocol.messages import MapDelta, Pose, SensingEvent
 
 

@@ -30,8 +30,8 @@ from typing import Any
 import msgpack
 import numpy as np
 
-from model.exact_coverage import ExactKernel
 from model.parameters import exact_kernel_of
+from model.radio.exact_coverage import ExactKernel
 from model.scenario import Scenario
 
 PROTOCOL_VERSION = 1
@@ -97,7 +97,7 @@ class AgentState:
     omega: float
     e_omega: float
     next_pose: Pose
-    safety: int = 0  # what the safety filter did this step (model.safety flag bits; 0: nothing)
+    safety: int = 0  # what the safety filter did this step (model.safety.safety flag bits; 0: nothing)
     stamp: float = 0.0  # realtime: the wall-clock time (time.time(), s) it reached next_pose; 0 in lockstep
 
 

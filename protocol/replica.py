@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from model.coverage_map import CoverageMap
+from model.paper.coverage_map import CoverageMap
 from model.parameters import coverage_map_of
 from model.scenario import Scenario
 from protocol.messages import MapDelta, Snapshot

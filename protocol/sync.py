@@ -1,4 +1,4 @@
-"""Anti-entropy over the bus (issue 13): the rule of :mod:`model.radio` between processes.
+"""Anti-entropy over the bus (issue 13): the rule of :mod:`model.radio.radio` between processes.
 
 With a limited ``comm_range`` a robot takes only the steps of teammates in range, so replicas diverge.
 Every ``SYNC_PERIOD`` seconds a robot sends each teammate it is in contact with its summary, the

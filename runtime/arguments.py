@@ -9,23 +9,29 @@ from __future__ import annotations
 
 import argparse
 
+from model.controllers import choices, controller_of
 from model.parameters import starting_poses
-from model.scenario import CONTROLLER_CHOICES, PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
+from model.scenario import PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
 
 CLOCKS = ("lockstep", "realtime")
 
 
-def add_scenario_arguments(parser: argparse.ArgumentParser, controllers: tuple[str, ...] = CONTROLLER_CHOICES) -> None:
+def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
     """--config, --n, --seed, --controller: which scenario, with overrides of its keys."""
     parser.add_argument("--config", help="scenario TOML (default: scenarios/paper.toml)")
     parser.add_argument("--n", type=int, help="team size (overrides the scenario's 'agents'; the paper's is 4)")
     parser.add_argument("--seed", type=int, help="seed of the initial poses (overrides 'seed')")
-    parser.add_argument("--controller", choices=controllers, help="control law (overrides 'controller')")
+    parser.add_argument(
+        "--controller",
+        metavar="NAME",
+        help=f"controller (overrides 'controller'): one of {', '.join(choices())}, or module.path:Class or "
+        "path/to/file.py:Class (docs/controllers.md)",
+    )
 
 
 def add_team_arguments(parser: argparse.ArgumentParser) -> None:
-    """The scenario arguments of a team on the bus (no zig-zag there), and its clock."""
-    add_scenario_arguments(parser, tuple(c for c in CONTROLLER_CHOICES if c not in ("zigzag", "boustrophedon")))
+    """The scenario arguments of a team on the bus, and its clock."""
+    add_scenario_arguments(parser)
     parser.add_argument(
         "--clock",
         choices=CLOCKS,
@@ -73,6 +79,12 @@ def scenario_from_arguments(args: argparse.Namespace) -> Scenario:
         raise ScenarioError(
             f"scenario key 'comm_range' ({scenario.comm_range}): a limited radio needs --clock realtime on the bus "
             "(lockstep steps travel in the coordinator's go); leave comm_range out, or run it with anicov run"
+        )
+    if getattr(args, "clock", None) is not None and not controller_of(scenario).supports.team:
+        # A team command (it has a clock): every robot must decide step by step on its own.
+        raise ScenarioError(
+            f"scenario key 'controller': '{scenario.controller}' flies paths planned once for the team and runs "
+            "in process only (anicov run, anicov sweep)"
         )
     if getattr(args, "no_coordinator", False):
         check_no_coordinator(scenario, getattr(args, "clock", None))

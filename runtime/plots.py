@@ -13,7 +13,7 @@ from matplotlib.patches import Circle
 
 from model.run import RunResult
 from model.scenario import Scenario
-from model.world import world_of
+from model.world.world import world_of
 
 
 def plot_domain_error(result: RunResult, path: Path) -> None:

@@ -11,11 +11,11 @@ import os
 from pathlib import Path
 from typing import Any
 
-from model.fixed_point import COVERAGE_SCALE
-from model.metrics import optimum_time, total_sensing_ability
+from model.paper.fixed_point import COVERAGE_SCALE
+from model.paper.metrics import optimum_time, total_sensing_ability
 from model.run import RunResult
-from model.safety_record import safety_figures
-from model.world import World, world_of
+from model.safety.safety_record import safety_figures
+from model.world.world import World, world_of
 
 TRAJECTORY_HEADER = "t,agent,x,y,theta,v,omega"
 

@@ -10,7 +10,7 @@ import pytest
 from model.scenario import load_scenario, validate
 from protocol.agreement import ScenarioMismatch, check_agreement, digest_of
 from tests.conftest import write_map
-from tests.teamrun import ROOT, anicov_command, free_port, unique_team, write_scenario
+from tests.teamrun import ROOT, anicov_command, free_port, limit, unique_team, write_scenario
 
 
 def _walled_map(folder, name: str, door: int = 10):
@@ -63,7 +63,7 @@ def test_an_agent_with_another_map_refuses_to_join_the_coordinators_run(tmp_path
             cwd=ROOT,
             capture_output=True,
             text=True,
-            timeout=120,
+            timeout=limit(120),
         )
         assert agent.returncode == 2, agent.stderr
         assert "agent 0 refuses to join" in agent.stderr and "the coordinator's map has" in agent.stderr
@@ -71,4 +71,4 @@ def test_an_agent_with_another_map_refuses_to_join_the_coordinators_run(tmp_path
     finally:
         for process in (coordinator, router):
             process.terminate()
-            process.wait(timeout=30)
+            process.wait(timeout=limit(60))

@@ -35,9 +35,9 @@ def test_a_speed_that_is_not_positive_is_refused_by_name():
 
 
 def test_a_team_on_the_bus_cannot_ask_for_the_zigzag_pilot():
-    with pytest.raises(SystemExit):
-        parse(add_process_arguments, "--controller", "zigzag")
-    assert parse(add_scenario_arguments, "--controller", "zigzag").controller == "zigzag"
+    with pytest.raises(ScenarioError, match="'controller': 'zigzag' flies paths planned once for the team"):
+        scenario_from_arguments(parse(add_process_arguments, "--controller", "zigzag"))
+    assert scenario_from_arguments(parse(add_scenario_arguments, "--controller", "zigzag")).controller == "zigzag"
 
 
 @pytest.mark.parametrize("part", [agent_command, coordinator_command, logger_command])

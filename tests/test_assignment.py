@@ -2,7 +2,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from model.assignment import assign_objectives, normalised_distances
+from model.paper.assignment import assign_objectives, normalised_distances
 
 points = st.lists(st.tuples(st.floats(0, 100), st.floats(0, 100)), min_size=1, max_size=30)
 

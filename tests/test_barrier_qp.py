@@ -1,4 +1,4 @@
-"""The filter's QP (model.barrier_qp) against quadprog's Goldfarb–Idnani solver on random polygons."""
+"""The filter's QP (model.safety.barrier_qp) against quadprog's Goldfarb–Idnani solver on random polygons."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import quadprog
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.barrier_qp import project_onto_polygon
+from model.safety.barrier_qp import project_onto_polygon
 
 finite = st.floats(-5.0, 5.0, allow_nan=False)
 

@@ -1,4 +1,4 @@
-"""model.clearance: a robot in a corridor never touches its walls, and never leaves a map."""
+"""model.world.clearance: a robot in a corridor never touches its walls, and never leaves a map."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.clearance import _segment_square_distance2, disk_is_free, step_or_stay, swept_disk_is_free
+from model.world.clearance import _segment_square_distance2, disk_is_free, step_or_stay, swept_disk_is_free
 
 
 def corridor() -> np.ndarray:

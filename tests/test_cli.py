@@ -5,11 +5,12 @@ import subprocess
 import sys
 
 from tests.conftest import ROOT
+from tests.teamrun import limit
 
 
 def anicov(*args, cwd=ROOT):
     return subprocess.run(
-        [sys.executable, "-m", "anicov.cli", *args], cwd=cwd, capture_output=True, text=True, timeout=300
+        [sys.executable, "-m", "anicov.cli", *args], cwd=cwd, capture_output=True, text=True, timeout=limit(300)
     )
 
 
@@ -77,3 +78,23 @@ def test_reproduce_small_writes_json_table_and_figures(tmp_path):
     assert "| d100 (Fig. 7) | 2.72 |" in (tmp_path / "reproduction.md").read_text()
     for name in ("fig7_straight_pass.png", "fig8_zigzag.png", "fig9_time_ratio.png", "fig10_path_length.png"):
         assert (tmp_path / name).stat().st_size > 1000
+
+
+def test_launch_passes_every_flag_to_launch_team_help_included():
+    done = anicov("launch", "--help")
+    assert done.returncode == 0, done.stderr
+    assert "usage: launch_team.py" in done.stdout and "--controller NAME" in done.stdout
+
+
+def test_a_plug_in_that_returns_nan_ends_the_run_with_its_name_and_exit_3(tmp_path):
+    (tmp_path / "nan_plugin.py").write_text(
+        "from model.controllers import Controller\n\n\n"
+        "class NaNAtOnce(Controller):\n"
+        "    name = 'nan-at-once'\n\n"
+        "    def command(self, view):\n"
+        "        return float('nan'), 0.0\n"
+    )
+    done = anicov("run", "--controller", "nan_plugin.py:NaNAtOnce", "--out", str(tmp_path / "o"), cwd=tmp_path)
+    assert done.returncode == 3
+    assert "nan_plugin.py:NaNAtOnce', robot 0, step 0: command() returned (v, omega) = (nan, 0.0)" in done.stderr
+    assert "Traceback" not in done.stderr

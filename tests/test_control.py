@@ -4,7 +4,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from model.control import combined_law, global_law, local_law
+from model.paper.control import combined_law, global_law, local_law
 
 F = math.radians(27.0)
 unit = st.floats(0.0, 1.0)
@@ -66,7 +66,7 @@ def test_no_local_error_follows_global_law():
 
 
 def test_pursuit_law_stands_and_turns_toward_a_carrot_within_the_face_radius():
-    from model.control import pursuit_law
+    from model.paper.control import pursuit_law
 
     # A carrot 0.02 away at bearing 1 rad: stand, turn toward it at the bound (π k_ω), not beyond it.
     v, omega = pursuit_law(5.0, 5.0, 0.0, 5.0 + 0.02 * math.cos(1.0), 5.0 + 0.02 * math.sin(1.0), 1.0, 1.0, 0.1,

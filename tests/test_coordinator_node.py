@@ -7,11 +7,12 @@ import math
 import numpy as np
 
 from coordinator.node import Coordinator, CoordinatorOptions
-from model.coverage_map import CoverageMap
-from model.ground import NO_FIELD, NO_POSITIONS, open_ground
-from model.parameters import initial_poses, law_parameters
+from model.controllers import law_parameters
+from model.paper.coverage_map import CoverageMap
+from model.parameters import initial_poses
 from model.scenario import Scenario
 from model.step import decide_and_sense, move, no_look
+from model.world.ground import NO_FIELD, NO_POSITIONS, open_ground
 from protocol.inbox import Membership, Received
 from protocol.messages import AgentState, AgentStep, MapDelta
 

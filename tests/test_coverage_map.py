@@ -3,8 +3,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.coverage_map import CoverageMap
-from model.fixed_point import COVERAGE_SCALE
+from model.paper.coverage_map import CoverageMap
+from model.paper.fixed_point import COVERAGE_SCALE
 
 window = st.tuples(
     st.integers(0, 7), st.integers(0, 7), st.lists(st.integers(0, 60 * COVERAGE_SCALE), min_size=9, max_size=9)

@@ -11,7 +11,7 @@ import uuid
 
 import pytest
 
-from tests.teamrun import ROOT, anicov, write_scenario
+from tests.teamrun import ROOT, anicov, limit, write_scenario
 
 ROUTER_ADDRESS = "10.213.77.1"
 ROBOT_ADDRESS = "10.213.77.2"
@@ -96,16 +96,16 @@ def test_team_across_two_network_namespaces_equals_engine(tmp_path, two_hosts):
             processes.append(
                 subprocess.Popen(in_namespace(robot_ns, "agent", *team, "--id", str(agent)), cwd=ROOT, env=environment)
             )
-        _, stderr = coordinator.communicate(timeout=240)
+        _, stderr = coordinator.communicate(timeout=limit(240))
         assert coordinator.returncode == 0, stderr
         for agent_process in processes[2:]:
-            assert agent_process.wait(timeout=30) == 0
+            assert agent_process.wait(timeout=limit(60)) == 0
     finally:
         for process in processes:
             if process.poll() is None:
                 process.terminate()
                 try:
-                    process.wait(timeout=10)
+                    process.wait(timeout=limit(30))
                 except subprocess.TimeoutExpired:
                     process.kill()
     for name in ("trajectory.csv", "summary.json"):

@@ -5,10 +5,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model.coverage_map import add_window
-from model.deposit import Deposit
+from model.controllers.anicov.deposit import Deposit
+from model.paper.coverage_map import add_window
 from model.scenario import load_scenario
-from model.sensing import sense_wedge_among
+from model.world.wedge import sense_wedge_among
 
 PAPER = Path(__file__).resolve().parents[1] / "scenarios" / "paper.toml"
 

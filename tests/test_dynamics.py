@@ -4,7 +4,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from model.dynamics import unicycle_step
+from model.paper.dynamics import unicycle_step
 
 
 def test_straight_line():

@@ -2,12 +2,12 @@ import numpy as np
 import pytest
 
 from anicov.engine import run_scenario
-from model.clearance import disk_is_free
-from model.metrics import optimum_time, total_sensing_ability
+from model.paper.metrics import optimum_time, total_sensing_ability
 from model.parameters import initial_poses
 from model.run import TRACE_FIELDS
 from model.scenario import validate
-from model.world import world_of
+from model.world.clearance import disk_is_free
+from model.world.world import world_of
 from runtime.rundir import format_summary, summary_of
 
 

@@ -9,11 +9,12 @@ import msgpack
 import numpy as np
 import pytest
 
-from model.occlusion import teammates_in_view
-from model.parameters import coverage_map_of, law_parameters
+from model.controllers import law_parameters
+from model.parameters import coverage_map_of
 from model.scenario import PAPER_SCENARIO, load_scenario
 from model.step import read_wedge
-from model.world import world_of
+from model.world.occlusion import teammates_in_view
+from model.world.world import world_of
 from protocol.decoding import decode
 from protocol.events import as_event
 from protocol.messages import PROTOCOL_VERSION, AgentState, AgentStep, Limits, MapDelta, ProtocolError, StepGo, encode

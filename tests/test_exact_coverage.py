@@ -1,4 +1,4 @@
-"""model.exact_coverage: the integer kernel gives the float kernel's ticks on all but a handful of cells,
+"""model.radio.exact_coverage: the integer kernel gives the float kernel's ticks on all but a handful of cells,
 and always the same integers (a digest of them is pinned: any CPU must reproduce it)."""
 
 from __future__ import annotations
@@ -9,11 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from model.exact_coverage import event_ticks, event_window, exact_kernel
-from model.parameters import coverage_map_of, exact_kernel_of, law_parameters
+from model.controllers import law_parameters
+from model.parameters import coverage_map_of, exact_kernel_of
+from model.radio.exact_coverage import event_ticks, event_window, exact_kernel
 from model.scenario import PAPER_SCENARIO, load_scenario
 from model.step import read_wedge
-from model.world import world_of
+from model.world.world import world_of
 
 PAPER = load_scenario(PAPER_SCENARIO)
 

@@ -24,13 +24,15 @@ from protocol.messages import AgentState, AgentStep, Limits, MapDelta, Objective
 from protocol.session import zenoh_config
 from tests.teamrun import (
     anicov,
-    anicov_command,
     free_port,
     launched_team,
     launcher_command,
+    limit,
+    log_says,
+    parked,
     processes_of,
     run,
-    running,
+    run_progress,
     unique_team,
     wait_for,
     write_scenario,
@@ -63,18 +65,27 @@ def log_time(line: str) -> float:
     return datetime.strptime(stamp, "%Y-%m-%d %H:%M:%S,%f").timestamp()
 
 
+KILL_STEP = 800
+"""Where the fault tests kill a process: a quarter into the half-area runs (3,070 steps in lockstep; at
+speed 40, 400 steps a second, 2 s into 7.7 s), more than half into the anicov controller's 60 x 60 run."""
+
+
 @pytest.mark.parametrize("clock", ["lockstep", "realtime"])
 def test_team_survives_an_agent_killed_mid_run(tmp_path, clock):
-    team = unique_team()
+    team, port = unique_team(), free_port()
     out = tmp_path / "run"
     extra = ["--speed", "40"] if clock == "realtime" else []
     square = write_scenario(tmp_path / "s.toml", domain=[70.0, 70.0], agents=4, seed=0)  # half the paper's area
-    with launched_team("--config", str(square), "--clock", clock, *extra, "--out", str(out), team=team) as process:
-        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
-        time.sleep(2.0)  # well into the run
+    with (
+        launched_team(
+            "--config", str(square), "--clock", clock, *extra, "--out", str(out), team=team, port=port
+        ) as process,
+        run_progress(port, team) as progress,
+    ):
+        progress.wait_for_step(KILL_STEP, process)  # well into the run
         killed_at = time.time()
         os.kill(agent_pid(team, 2), signal.SIGKILL)
-        stdout, stderr = process.communicate(timeout=400)
+        stdout, stderr = process.communicate(timeout=limit(400))
     assert process.returncode == 0, stderr + stdout
     assert "lost on the way agent-2" in stdout
     summary = json.loads((out / "summary.json").read_text())
@@ -93,7 +104,7 @@ def test_team_survives_an_agent_killed_mid_run(tmp_path, clock):
     # Every delta agent 2 published stays: the same sequences of it, and the same map, everywhere.
     assert len({(c["map_digest"], c["applied"]["2"]) for c in (counts, *survivors)}) == 1
     (out / "detection_seconds.json").write_text(json.dumps(detected_after, indent=1))
-    assert wait_for(lambda: processes_of(team) == [], timeout=10)
+    assert wait_for(lambda: processes_of(team) == [], timeout=60)
 
 
 # ------------------------------------------------------------------ fuzzing
@@ -244,7 +255,7 @@ def fuzz_a_running_team(tmp_path, domain: list[float], payloads: int) -> None:
             outlasted = process.poll() is None and not run_ended(out / "logs")
             # The session stays open until the team exits: closed at once, it could drop what its queue
             # still held (2026-12-03: 260 payloads a key reached nobody when the fuzzer closed at its cap).
-            stdout, stderr = process.communicate(timeout=300)
+            stdout, stderr = process.communicate(timeout=limit(300))
     assert process.returncode == 0, stderr + stdout
     assert outlasted, f"the run ended after {sent} of {payloads} payloads: give the fuzz a longer run"
     # The map, the trajectories, everything equals the run without the noise.
@@ -279,24 +290,29 @@ def test_a_late_logger_catches_up_from_the_snapshot_and_records_the_full_final_m
     from logger.replay import summarise_recording
     from model.scenario import load_scenario
 
-    # 8,044 lockstep steps (5-8 s here): long enough that a logger started 0.5 s in, which needs 1.5-2 s
-    # to import and connect, joins mid-run (a 60 x 60 run of 2,366 steps sometimes ended first).
+    # 8,044 lockstep steps. The logger is started before the run and parked, its imports done, until the
+    # run is at step 500: it then joins mid-run in the time its session and snapshot take, whatever the
+    # machine's speed (started 0.5 s in and left to import, it needed 1.5 - 2 s, and a 60 x 60 run of
+    # 2,366 steps sometimes ended first).
     config = write_scenario(tmp_path / "s.toml", domain=[100.0, 100.0], agents=3, seed=4)
     team = unique_team()
     port = free_port()
     out = tmp_path / "team"
     recording = tmp_path / "late.rrd"
-    late_logger = anicov_command(
+    late_logger = [
         "logger", "--team", team, "--config", str(config), "--connect", f"tcp/127.0.0.1:{port}", "--out", str(recording)
-    )
-    with launched_team("--config", str(config), "--out", str(out), "--no-record", team=team, port=port) as process:
-        assert wait_for(lambda: agents_started(out / "logs", 3), timeout=120)
-        time.sleep(0.5)  # the team is under way before the logger exists (and it takes a second to start)
-        with running(late_logger) as logger:
-            stdout, stderr = process.communicate(timeout=300)
-            assert process.returncode == 0, stderr + stdout
-            _, logger_err = logger.communicate(timeout=60)
-            assert logger.returncode == 0, logger_err
+    ]  # fmt: skip
+    with (
+        launched_team("--config", str(config), "--out", str(out), "--no-record", team=team, port=port) as process,
+        run_progress(port, team) as progress,
+        parked(late_logger, ["logger.process", "protocol.session", "runtime.lifecycle"], tmp_path, "logger") as logger,
+    ):
+        progress.wait_for_step(500, process)  # the team is under way before the logger exists
+        logger.release()
+        stdout, stderr = process.communicate(timeout=limit(300))
+        assert process.returncode == 0, stderr + stdout
+        assert logger.wait() == 0, logger.log.read_text()
+    logger_err = logger.log.read_text()
     loaded = re.search(r"loaded the coordinator's snapshot \(e_D = ([0-9.]+)\)", logger_err)
     assert loaded and float(loaded.group(1)) > 0.0  # it joined mid-run, not after the end
     content = summarise_recording(recording)
@@ -306,35 +322,45 @@ def test_a_late_logger_catches_up_from_the_snapshot_and_records_the_full_final_m
     assert content.final_domain_error == 0.0
 
 
-# Realtime (30 s of wall clock: the run must outlast the restarted process's start) is in the slow set;
-# the lockstep case runs the same kill, restart and snapshot, and checks every replica bit for bit.
+AGENT_PRELOAD = ["agents.process", "protocol.session", "runtime.lifecycle"]
+"""What an agent process imports before it says hello: a parked agent (tests.teamrun.parked) has it."""
+
+
+# Realtime (30 s of wall clock) is in the slow set; the lockstep case runs the same kill, restart and
+# snapshot, and checks every replica bit for bit.
 @pytest.mark.parametrize("clock", ["lockstep", pytest.param("realtime", marks=pytest.mark.slow)])
 def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_path, clock):
-    """Agent 1 SIGKILLed 2 s in and started again 1 s later with the same id: it loads the coordinator's
-    snapshot and rejoins (lockstep: from the next go that lists it); every replica ends the same."""
+    """Agent 1 SIGKILLed at step 1,000 and started again, once the coordinator has seen it leave, with the
+    same id: it loads the coordinator's snapshot and rejoins (lockstep: from the next go that lists it);
+    every replica ends the same."""
     team = unique_team()
     port = free_port()
     out = tmp_path / "run"
-    # Realtime at speed 25: the run lasts long enough for the restarted process to rejoin (it takes 13 - 17 s
-    # on this 2-core VM to start, fetch the snapshot and be admitted; at speed 40 the run sometimes ended first).
+    # The new process is started before the kill and parked, its imports done, until the coordinator has
+    # seen agent 1 leave: it joins in the time its session, snapshot and hello take (under a second), far
+    # inside the run's remaining 5,800 steps, however busy the machine (a fresh process's start took 13 -
+    # 17 s on this 2-core VM under load, and once, on a fresh clone's CI run, outlasted the whole run).
     speed = ("--speed", "25") if clock == "realtime" else ()
-    agent_again = anicov_command(
+    agent_again = [
         "agent", "--team", team, "--id", "1", "--n", "4", "--seed", "0", "--clock", clock, *speed,
         "--connect", f"tcp/127.0.0.1:{port}", "--counts", str(tmp_path / "restarted.json"),
-    )  # fmt: skip
-    with launched_team(
-        "--n", "4", "--seed", "0", "--clock", clock, *speed, "--out", str(out), team=team, port=port
-    ) as process:
-        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
-        time.sleep(2.0)
+    ]  # fmt: skip
+    logs = out / "logs"
+    with (
+        launched_team(
+            "--n", "4", "--seed", "0", "--clock", clock, *speed, "--out", str(out), team=team, port=port
+        ) as process,
+        run_progress(port, team) as progress,
+        parked(agent_again, AGENT_PRELOAD, tmp_path, "restarted") as restarted,
+    ):
+        progress.wait_for_step(1000, process)
         os.kill(agent_pid(team, 1), signal.SIGKILL)
-        time.sleep(1.0)
-        spawned_at = time.time()
-        with running(agent_again) as restarted:
-            stdout, stderr = process.communicate(timeout=400)
-            _, restarted_log = restarted.communicate(timeout=60)
+        assert wait_for(lambda: log_says(logs / "coordinator.log", "agent 1 left"), timeout=120)
+        restarted.release()
+        stdout, stderr = process.communicate(timeout=limit(400))
+        assert restarted.wait() == 0, restarted.log.read_text()
+    restarted_log = restarted.log.read_text()
     assert process.returncode == 0, stderr + stdout
-    assert restarted.returncode == 0, restarted_log
     resumed = re.search(r"resumes from the coordinator's snapshot after step (\d+)", restarted_log)
     assert resumed and int(resumed.group(1)) > 0
     coordinator = json.loads((out / "coordinator_counts.json").read_text())
@@ -350,7 +376,8 @@ def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_p
         assert all(counts["gaps"] == 0 for counts in everyone)
     assert json.loads((out / "summary.json").read_text())["completed"] is True
     rejoined = [line for line in (out / "logs" / "coordinator.log").read_text().splitlines() if "rejoined" in line]
-    (out / "rejoin_seconds.txt").write_text(f"{log_time(rejoined[0]) - spawned_at:.3f}\n")  # process start → member
+    # Released (its imports done) → a member again: its session, the snapshot, the hello, the admission.
+    (out / "rejoin_seconds.txt").write_text(f"{log_time(rejoined[0]) - restarted.released_at:.3f}\n")
 
 
 def assert_every_replica_holds_every_published_delta_once(out, agents: int) -> list[dict]:
@@ -409,14 +436,16 @@ def test_a_dead_agents_lost_deltas_come_from_its_teammates_relays(tmp_path):
     """Realtime, 10 % loss, agent 2 killed mid-run: the deltas it sent just before dying that some
     replica lost can no longer come from its history; teammates relay them, and every replica ends
     with the same map, holding every delta of agent 2 that any replica received."""
-    team = unique_team()
+    team, port = unique_team(), free_port()
     out = tmp_path / "run"
     square = write_scenario(tmp_path / "s.toml", domain=[70.0, 70.0], agents=4, seed=0)  # half the paper's area
-    with launched_team(*REALTIME_WITH_LOSS, "--config", str(square), "--out", str(out), team=team) as process:
-        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
-        time.sleep(2.0)  # well into the run
+    with (
+        launched_team(*REALTIME_WITH_LOSS, "--config", str(square), "--out", str(out), team=team, port=port) as process,
+        run_progress(port, team) as progress,
+    ):
+        progress.wait_for_step(KILL_STEP, process)  # well into the run
         os.kill(agent_pid(team, 2), signal.SIGKILL)
-        stdout, stderr = process.communicate(timeout=400)
+        stdout, stderr = process.communicate(timeout=limit(400))
     assert process.returncode == 0, stderr + stdout
     assert json.loads((out / "summary.json").read_text())["completed"] is True
     coordinator = json.loads((out / "coordinator_counts.json").read_text())
@@ -432,7 +461,7 @@ def test_a_dead_agents_lost_deltas_come_from_its_teammates_relays(tmp_path):
     # next gap check: the relay path was taken (this fails only if the loss hook is broken).
     assert sum(counts["relayed"] for counts in everyone) > 0
     (out / "relayed.json").write_text(json.dumps([counts["relayed"] for counts in everyone]))
-    assert wait_for(lambda: processes_of(team) == [], timeout=10)
+    assert wait_for(lambda: processes_of(team) == [], timeout=60)
 
 
 @pytest.mark.parametrize(
@@ -444,7 +473,7 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     """SIGKILL the coordinator mid-run: the launcher starts a new one, which rebuilds Λ, e_D, the trace
     and the planner's memory from the agents' histories. Lockstep still equals the engine byte for byte.
     An agent killed before the coordinator left no history: its coverage comes from a member's replica."""
-    team = unique_team()
+    team, port = unique_team(), free_port()
     out = tmp_path / "run"
     # Realtime runs the anicov controller, on a smaller square: its routes, cut once at the first plan,
     # must be cut again and each robot put back on its own (the paper's law keeps nothing a realtime
@@ -455,15 +484,19 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     else:  # half the paper's area: the run still lasts well past the kill
         square = write_scenario(tmp_path / "s.toml", domain=[70.0, 70.0], agents=4, seed=0)
         extra = ["--config", str(square)]
-    with launched_team("--clock", clock, *extra, "--out", str(out), team=team) as process:
-        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
-        time.sleep(2.0)  # well into the run
-        if agent_dies_first:
+    logs = out / "logs"
+    with (
+        launched_team("--clock", clock, *extra, "--out", str(out), team=team, port=port) as process,
+        run_progress(port, team) as progress,
+    ):
+        progress.wait_for_step(KILL_STEP, process)  # well into the run
+        if agent_dies_first:  # and gone for the coordinator and every teammate before the coordinator dies
             os.kill(agent_pid(team, 2), signal.SIGKILL)
-            time.sleep(1.0)
+            gone = [("coordinator", "agent 2 left"), *((f"agent-{i}", "teammate 2 left") for i in (0, 1, 3))]
+            assert wait_for(lambda: all(log_says(logs / f"{name}.log", says) for name, says in gone), timeout=120)
         killed_at = time.time()
         os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
-        stdout, stderr = process.communicate(timeout=400)
+        stdout, stderr = process.communicate(timeout=limit(400))
     assert process.returncode == 0, stderr + stdout
     assert "coordinator     killed and restarted 1 time(s)" in stdout
     if agent_dies_first:
@@ -491,4 +524,4 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
         if "resumed at step" in line
     ]
     (out / "coordinator_restart_seconds.txt").write_text(f"{log_time(resumed[0]) - killed_at:.3f}\n")
-    assert wait_for(lambda: processes_of(team) == [], timeout=10)
+    assert wait_for(lambda: processes_of(team) == [], timeout=60)

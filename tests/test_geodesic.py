@@ -1,4 +1,4 @@
-"""model.geodesic: distance fields around walls, and a way to follow them that never stalls at a wall."""
+"""model.world.geodesic: distance fields around walls, and a way to follow them that never stalls at a wall."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from model.clearance import disk_is_free, step_or_stay
-from model.geodesic import descent_waypoint, distance_fields, entry_cell, length_by_field, passable_cells
+from model.world.clearance import disk_is_free, step_or_stay
+from model.world.geodesic import descent_waypoint, distance_fields, entry_cell, length_by_field, passable_cells
 
 
 def wall_with_a_gap() -> np.ndarray:

@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from model.geometry import square_gap2, wedge_bounds, wedge_cell_range, wrap_angle
+from model.paper.geometry import square_gap2, wedge_bounds, wedge_cell_range, wrap_angle
 
 angles = st.floats(-50.0, 50.0, allow_nan=False)
 

@@ -1,4 +1,4 @@
-"""model.lane_planner: the anicov controller's carrots along its routes, and the passes over what is left."""
+"""model.controllers.anicov.lane_planner: the anicov controller's carrots along its routes, and the passes over what is left."""
 
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from anicov.engine import run_scenario
-from model.control import pursuit_law
-from model.geometry import wrap_angle
-from model.lane_planner import LOOKAHEAD, LanePlanner, blob_passes
+from model.controllers.anicov.lane_planner import LOOKAHEAD, LanePlanner, blob_passes
+from model.paper.control import pursuit_law
+from model.paper.geometry import wrap_angle
 from model.scenario import Scenario, ScenarioError, load_scenario
 
 PAPER = Scenario(stations=False)  # the spiral (tests/test_stations.py has the stations)
@@ -72,7 +72,7 @@ def test_carrots_lead_each_robot_along_its_route_and_a_robot_with_nothing_left_s
 )
 @example(0.0, 1.0, 3.1415926535897927, 1.0, 1.0, 0.0)  # the carrot straight behind: (2/π)|e_θ| rounded past 2
 def test_the_pursuit_law_keeps_the_papers_velocity_bounds(x, y, theta, goal_x, goal_y, weave):
-    """With or without a weave (model.weave): eq. 15-16's bounds |v| ≤ k_v, |ω| ≤ π k_ω."""
+    """With or without a weave (model.controllers.anicov.weave): eq. 15-16's bounds |v| ≤ k_v, |ω| ≤ π k_ω."""
     v, omega = pursuit_law(x, y, theta, goal_x, goal_y, 1.0, 1.0, 0.1, weave, 3.5)
     assert abs(v) <= 1.0 and abs(omega) <= math.pi + 1e-12
 
@@ -92,7 +92,7 @@ def test_the_pursuit_law_without_a_weave_is_pure_pursuit(x, y, theta, goal_x, go
 def test_best_names_the_anicov_controller_which_knows_no_walls_and_plans_centrally():
     assert PAPER.with_overrides(controller="best").controller == "anicov"
     assert PAPER.with_overrides(controller="anicov").plan_steps == 5  # a carrot every 0.5 time units
-    with pytest.raises(ScenarioError, match="'controller': 'anicov' flies the open domain's lanes"):
+    with pytest.raises(ScenarioError, match="'controller': 'anicov' knows no walls or robot bodies"):
         PAPER.with_overrides(controller="anicov", robot_radius=0.5)
     with pytest.raises(ScenarioError, match="'planning'"):
         PAPER.with_overrides(controller="anicov", planning="local")

@@ -4,7 +4,13 @@ import math
 
 import pytest
 
-from model.metrics import coverage_distance, optimum_time, pass_reach, straight_pass_coverage, total_sensing_ability
+from model.paper.metrics import (
+    coverage_distance,
+    optimum_time,
+    pass_reach,
+    straight_pass_coverage,
+    total_sensing_ability,
+)
 from model.scenario import Scenario
 
 R, ALPHA = 20.0, 50.0

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.ndimage import distance_transform_edt
 
-from model.objectives import BlobObjectives, by_paths_through, cell_of, fallback_objective, select_objectives
+from model.paper.objectives import BlobObjectives, by_paths_through, cell_of, fallback_objective, select_objectives
 
 CELL = 1.0
 R = 20.0

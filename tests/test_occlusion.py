@@ -1,4 +1,4 @@
-"""model.occlusion: the pruning never changes what the rule of model.visibility hides."""
+"""model.world.occlusion: the pruning never changes what the rule of model.world.visibility hides."""
 
 from __future__ import annotations
 
@@ -9,11 +9,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.fixed_point import COVERAGE_SCALE
-from model.ground import NO_POSITIONS, Ground
-from model.occlusion import _square_span, _square_span_by_corners
-from model.sensing import offset_from_heading, sense_wedge, wedge_reach
-from model.visibility import line_of_sight
+from model.paper.fixed_point import COVERAGE_SCALE
+from model.paper.sensing import offset_from_heading, wedge_reach
+from model.world.ground import NO_POSITIONS, Ground
+from model.world.occlusion import _square_span, _square_span_by_corners
+from model.world.visibility import line_of_sight
+from model.world.wedge import sense_wedge
 
 R, F, ALPHA, TARGET = 20.0, math.radians(27.0), 50.0, 100 * COVERAGE_SCALE
 

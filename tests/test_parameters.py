@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from model.clearance import disk_is_free
 from model.parameters import free_initial_poses, initial_poses
 from model.scenario import Scenario
-from model.terrain import load_occupancy_map, map_on_grid
+from model.scenario.terrain import load_occupancy_map, map_on_grid
+from model.world.clearance import disk_is_free
 from tests.conftest import ROOT
 
 

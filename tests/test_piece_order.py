@@ -1,4 +1,4 @@
-"""model.piece_order: pieces cut for an order of robots, the order's finish, its local search, and the run-up
+"""model.controllers.anicov.piece_order: pieces cut for an order of robots, the order's finish, its local search, and the run-up
 before the spiral's first point."""
 
 from __future__ import annotations
@@ -8,9 +8,16 @@ import itertools
 import numpy as np
 import pytest
 
-from model.lane_planner import LOOKAHEAD
-from model.piece_order import Spiral, cuts_for, improved_order, neighbours, order_finishes, start_run_ups
-from model.routes import (
+from model.controllers.anicov.lane_planner import LOOKAHEAD
+from model.controllers.anicov.piece_order import (
+    Spiral,
+    cuts_for,
+    improved_order,
+    neighbours,
+    order_finishes,
+    start_run_ups,
+)
+from model.controllers.anicov.routes import (
     CENTRE_ALLOWANCE_LEADS,
     SEAM_OVERLAP,
     Route,
@@ -21,9 +28,9 @@ from model.routes import (
     spiral_path,
     with_run_up,
 )
+from model.controllers.anicov.touch_ups import simulate_routes
+from model.paper.polyline import path_between
 from model.scenario import Scenario
-from model.touch_ups import simulate_routes
-from model.zigzag import path_between
 
 PAPER = Scenario().with_overrides(controller="anicov")
 SPACING = best_lane_spacing(PAPER)
@@ -111,7 +118,7 @@ def test_the_improved_order_finds_the_best_of_all_orders_of_five_and_is_never_la
     order, finish = improved_order(worst, positions, cut_on)
     assert finish == pytest.approx(finishes.min(), abs=1e-6) and finishes.min() < finishes.max() - 40.0
     assert finish == pytest.approx(float(order_finishes(order[None, :], positions, cut_on)[0]))
-    # From the resized pieces' own order (model.routes), never later than they were estimated.
+    # From the resized pieces' own order (model.controllers.anicov.routes), never later than they were estimated.
     scenario = PAPER.with_overrides(agents=8, seed=5)
     positions = np.random.default_rng(5).uniform(0.0, 100.0, (8, 2))
     _, resized, owners = balanced_routes_on(scenario, cut_on.points, positions, LEAD)

@@ -1,4 +1,4 @@
-"""model.radio: contact, one-hop anti-entropy, local planning's members, divergence."""
+"""model.radio.radio: contact, one-hop anti-entropy, local planning's members, divergence."""
 
 import math
 
@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.radio import contacts, divergence, local_members, merge_knowledge
+from model.radio.radio import contacts, divergence, local_members, merge_knowledge
 
 
 def test_contacts_are_symmetric_reflexive_and_cut_at_the_range():

@@ -65,7 +65,7 @@ def test_the_paper_summary_has_no_radio_keys(small):
         ({"planning": "everywhere"}, "scenario key 'planning': expected one of central, local"),
         (
             {"planning": "local", "controller": "zigzag"},
-            "controller 'zigzag' flies lanes planned for the whole team at once",
+            "scenario key 'planning': 'local' runs the planner on each robot; controller 'zigzag' plans for the whole team",
         ),
         ({"robot_radius": 0.5, "comm_range": 2.0}, "scenario key 'comm_range': expected at least safety_range"),
     ],

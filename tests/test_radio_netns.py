@@ -12,7 +12,7 @@ import uuid
 
 import pytest
 
-from tests.teamrun import ROOT, unique_team, write_scenario
+from tests.teamrun import ROOT, limit, unique_team, write_scenario
 from tests.test_deploy_netns import _ip, _namespaces_available, in_namespace
 
 AGENTS = 8
@@ -97,16 +97,16 @@ def run_team(tmp_path, name: str, router_ns: str, robots: list[str], config) -> 
             counts = ["--counts", str(tmp_path / f"{name}-agent-{agent}.json")]
             command = in_namespace(robot_ns, "agent", *team, "--id", str(agent), *counts)
             processes.append(subprocess.Popen(command, cwd=ROOT, env=environment))
-        _, stderr = coordinator.communicate(timeout=400)
+        _, stderr = coordinator.communicate(timeout=limit(400))
         assert coordinator.returncode == 0, stderr
         for agent_process in processes[2:]:
-            assert agent_process.wait(timeout=60) == 0
+            assert agent_process.wait(timeout=limit(60)) == 0
     finally:
         for process in processes:
             if process.poll() is None:
                 process.terminate()
                 try:
-                    process.wait(timeout=10)
+                    process.wait(timeout=limit(30))
                 except subprocess.TimeoutExpired:
                     process.kill()
     return json.loads((out / "summary.json").read_text())

@@ -1,12 +1,12 @@
-"""model.reachability: an enclosed room and a pocket narrower than the robot cannot be covered."""
+"""model.world.reachability: an enclosed room and a pocket narrower than the robot cannot be covered."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from model.geodesic import passable_cells
-from model.reachability import coverable_cells, nearest_reachable, reachable_cells
-from model.terrain import load_occupancy_map, map_on_grid
+from model.scenario.terrain import load_occupancy_map, map_on_grid
+from model.world.geodesic import passable_cells
+from model.world.reachability import coverable_cells, nearest_reachable, reachable_cells
 from tests.conftest import ROOT
 
 

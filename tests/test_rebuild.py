@@ -8,8 +8,8 @@ import pytest
 
 from coordinator.node import Coordinator, CoordinatorOptions
 from coordinator.rebuild import by_step, rebuild, resume_step
-from model.coverage_map import CoverageMap
-from model.lane_planner import LanePlanner
+from model.controllers.anicov.lane_planner import LanePlanner
+from model.paper.coverage_map import CoverageMap
 from model.parameters import initial_poses
 from tests.test_coordinator_node import SCENARIO, team_steps
 

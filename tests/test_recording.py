@@ -110,7 +110,7 @@ def test_serve_hosts_a_web_viewer_and_a_grpc_server_while_the_file_is_still_writ
     import socket
     import urllib.request
 
-    from tests.teamrun import free_port, launched_team, wait_for
+    from tests.teamrun import free_port, launched_team, limit, wait_for
 
     web_port, grpc_port = free_port(), free_port()
     out = tmp_path / "run"
@@ -118,18 +118,25 @@ def test_serve_hosts_a_web_viewer_and_a_grpc_server_while_the_file_is_still_writ
 
     def page() -> bytes:
         try:
-            with urllib.request.urlopen(f"http://127.0.0.1:{web_port}/", timeout=2) as response:
+            with urllib.request.urlopen(f"http://127.0.0.1:{web_port}/", timeout=limit(30)) as response:
                 return response.read() if response.status == 200 else b""
         except OSError:
             return b""
 
     square = write_scenario(tmp_path / "s.toml", domain=[60.0, 60.0], agents=4, seed=0)
     with launched_team("--config", str(square), "--out", str(out), *serving) as process:
-        assert wait_for(lambda: page() != b"", timeout=120)
-        assert b"<html" in page().lower()
-        with socket.create_connection(("127.0.0.1", grpc_port), timeout=2):
+        served = b""
+
+        def serving() -> bool:  # keeps the page as it first comes: asked again, the run might be over
+            nonlocal served
+            served = page()
+            return served != b""
+
+        assert wait_for(serving, timeout=120)
+        assert b"<html" in served.lower()
+        with socket.create_connection(("127.0.0.1", grpc_port), timeout=limit(30)):
             pass  # the recording's gRPC server accepts viewers
-        stdout, stderr = process.communicate(timeout=400)
+        stdout, stderr = process.communicate(timeout=limit(400))
     assert process.returncode == 0, stderr + stdout
     announced = (out / "logs" / "logger.log").read_text()
     assert f":{web_port}/?url=rerun+http://" in announced and f":{grpc_port}/proxy" in announced

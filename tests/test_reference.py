@@ -7,11 +7,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.fixed_point import COVERAGE_SCALE
-from model.ground import NO_POSITIONS, open_ground
+from model.paper.fixed_point import COVERAGE_SCALE
 from model.reference import wedge_readings
-from model.sensing import sense_wedge
 from model.step import LawParameters
+from model.world.ground import NO_POSITIONS, open_ground
+from model.world.wedge import sense_wedge
 
 OPEN = (open_ground(), NO_POSITIONS, 0)  # the paper's open world: nothing hides anything
 

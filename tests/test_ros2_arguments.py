@@ -11,7 +11,7 @@ import sys
 import pytest
 
 from agents.ros2.arguments import RobotArgumentError, add_robot_arguments, ros2_options_from
-from tests.teamrun import ROOT, anicov
+from tests.teamrun import ROOT, anicov, limit
 
 
 def parse(*flags: str) -> argparse.Namespace:
@@ -97,7 +97,7 @@ def test_without_the_extra_the_agent_says_what_to_install_in_one_line():
         "from anicov.cli import main\n"
         "sys.exit(main(['agent', '--id', '0', '--robot', 'ros2', '--clock', 'realtime']))"
     )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=60)
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=limit(60))
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
     assert lines == [

@@ -1,4 +1,4 @@
-"""model.routes: the best spacing, the spiral and its symmetries, its pieces, who flies which, and progress."""
+"""model.controllers.anicov.routes: the best spacing, the spiral and its symmetries, its pieces, who flies which, and progress."""
 
 from __future__ import annotations
 
@@ -8,9 +8,8 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from model.lane_planner import LOOKAHEAD
-from model.metrics import coverage_distance, straight_pass_coverage
-from model.routes import (
+from model.controllers.anicov.lane_planner import LOOKAHEAD
+from model.controllers.anicov.routes import (
     CENTRE_ALLOWANCE_LEADS,
     ORDERED_VARIANTS,
     SEAM_OVERLAP,
@@ -25,6 +24,7 @@ from model.routes import (
     spiral_pieces,
     spiral_variants,
 )
+from model.paper.metrics import coverage_distance, straight_pass_coverage
 from model.scenario import Scenario
 
 PAPER = Scenario()

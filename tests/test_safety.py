@@ -1,4 +1,4 @@
-"""The safety filter alone (model.safety): for any states and nominal commands, the filtered command keeps
+"""The safety filter alone (model.safety.safety): for any states and nominal commands, the filtered command keeps
 the paper's velocity bounds and every barrier's discrete-time condition h_{k+1} ≥ (1 − γ)·h_k."""
 
 from __future__ import annotations
@@ -9,10 +9,9 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from model.dynamics import unicycle_step
-from model.ground import open_ground
+from model.paper.dynamics import unicycle_step
 from model.parameters import safety_parameters
-from model.safety import (
+from model.safety.safety import (
     DEADLOCK_FOUND,
     DEADLOCK_RESOLVED,
     FILTER_CHANGED,
@@ -23,7 +22,8 @@ from model.safety import (
     filter_command,
 )
 from model.scenario import validate
-from model.world import world_of
+from model.world.ground import open_ground
+from model.world.world import world_of
 
 SCENARIO = validate({"agents": 2, "robot_radius": 0.5, "safety_margin": 0.2})
 SAFETY = safety_parameters(SCENARIO)

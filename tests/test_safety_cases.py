@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from anicov.engine import run_scenario
-from model.safety import KEEPING_RIGHT
+from model.safety.safety import KEEPING_RIGHT
 from model.scenario import PAPER_SCENARIO, load_scenario
 from runtime.rundir import summary_of
 from tests.teamrun import anicov, launcher_command, processes_of, run, unique_team

@@ -1,4 +1,4 @@
-"""The safety figures of a run (model.safety_record)."""
+"""The safety figures of a run (model.safety.safety_record)."""
 
 from __future__ import annotations
 
@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 
-from model.ground import open_ground
-from model.safety import DEADLOCK_FOUND, DEADLOCK_RESOLVED, FILTER_CHANGED, RAN_LATE
-from model.safety_record import fill_unheard, min_clearance, min_separation, safety_figures
+from model.safety.safety import DEADLOCK_FOUND, DEADLOCK_RESOLVED, FILTER_CHANGED, RAN_LATE
+from model.safety.safety_record import fill_unheard, min_clearance, min_separation, safety_figures
 from model.scenario import validate
-from model.world import world_of
+from model.world.ground import open_ground
+from model.world.world import world_of
 
 
 def test_robots_crossing_between_two_steps_are_caught_on_the_chord():
@@ -49,7 +49,7 @@ def test_figures_count_the_flags():
 
 
 def test_realtime_separation_is_taken_on_the_wall_clock():
-    from model.safety_record import min_separation_in_time
+    from model.safety.safety_record import min_separation_in_time
 
     # Robot 0 moves along y = 0 from x = 0 to 10 over t 0..10; robot 1 stands at (5, 1) but was heard at
     # other instants: on the wall clock they pass 1 apart at t = 5.

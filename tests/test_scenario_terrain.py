@@ -1,4 +1,4 @@
-"""model.scenario_terrain: the terrain keys of a scenario, checked before anything runs."""
+"""model.scenario.terrain_keys: the terrain keys of a scenario, checked before anything runs."""
 
 from __future__ import annotations
 
@@ -50,7 +50,7 @@ def test_a_terrain_scenario_reports_its_terrain_keys():
         ({"occlusion": "yes"}, r"'occlusion': expected true or false"),
         ({"lambda_star": "nowhere.png"}, r"'lambda_star': the priority image .*nowhere.png does not exist"),
         ({"lambda_star_min": 3.0}, r"'lambda_star_min': only with lambda_star naming a priority image"),
-        ({"robot_radius": 0.5, "controller": "zigzag"}, r"'controller': 'zigzag' flies the open domain's lanes"),
+        ({"robot_radius": 0.5, "controller": "zigzag"}, r"'controller': 'zigzag' knows no walls or robot bodies"),
     ],
 )
 def test_bad_terrain_keys_name_the_key_and_what_is_expected(values, expected):

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import stat
-import time
 
 import pytest
 import zenoh
@@ -13,7 +12,7 @@ from cryptography.hazmat.primitives.asymmetric import ec
 
 from anicov.secure import access_control, load_profile, make_profile
 from protocol.session import zenoh_config
-from tests.teamrun import anicov, free_port, launcher_command, processes_of, run, write_scenario
+from tests.teamrun import anicov, free_port, launcher_command, processes_of, run, wait_for, write_scenario
 
 TEAM = "sec"
 
@@ -92,26 +91,36 @@ def test_plain_tcp_is_not_accepted_on_the_tls_port(router):
 
 
 def test_an_agent_cannot_publish_as_another_agent_or_as_the_coordinator(profile, router):
-    received: list[str] = []
+    received: list[tuple[str, bytes]] = []
+    own_step, own_token = f"anicov/{TEAM}/agent/1/step", f"anicov/{TEAM}/alive/agent/1"
     with (
         client(profile.directory, "coordinator", router) as coordinator,
         client(profile.directory, "agent-1", router) as agent,
     ):
-        coordinator.declare_subscriber(f"anicov/{TEAM}/**", lambda sample: received.append(str(sample.key_expr)))
-        time.sleep(0.5)  # the subscription reaches the router
+        coordinator.declare_subscriber(
+            f"anicov/{TEAM}/**", lambda sample: received.append((str(sample.key_expr), sample.payload.to_bytes()))
+        )
+        # The subscription reaches the router when a probe on the agent's own key comes through.
+        assert wait_for(lambda: (agent.put(own_step, b"probe"), (own_step, b"probe") in received)[1], timeout=60)
         for key in ("agent/0/step", "agent/0/history", "coordinator/go", "coordinator/objectives", "run/control"):
             agent.put(f"anicov/{TEAM}/{key}", b"spoofed")
-        agent.liveliness().declare_token(f"anicov/{TEAM}/alive/agent/0")
-        agent.put(f"anicov/{TEAM}/agent/1/step", b"own")  # after the spoofs, on the same link
-        deadline = time.monotonic() + 5.0
-        while f"anicov/{TEAM}/agent/1/step" not in received and time.monotonic() < deadline:
-            time.sleep(0.05)
-        time.sleep(0.3)
-        tokens = [
-            str(reply.ok.key_expr) for reply in coordinator.liveliness().get(f"anicov/{TEAM}/alive/**") if reply.ok
-        ]
-    assert received == [f"anicov/{TEAM}/agent/1/step"]
-    assert f"anicov/{TEAM}/alive/agent/0" not in tokens
+        spoofed_token = agent.liveliness().declare_token(f"anicov/{TEAM}/alive/agent/0")  # kept: undeclared if dropped
+        # After the spoofs, on the same link: once these are through, so is any spoof the router let pass.
+        agent.put(own_step, b"own")
+        token = agent.liveliness().declare_token(own_token)
+        assert wait_for(lambda: (own_step, b"own") in received, timeout=60)
+
+        def tokens() -> list[str]:
+            return [
+                str(reply.ok.key_expr) for reply in coordinator.liveliness().get(f"anicov/{TEAM}/alive/**") if reply.ok
+            ]
+
+        assert wait_for(lambda: own_token in tokens(), timeout=60)
+        alive = tokens()
+        token.undeclare()
+        spoofed_token.undeclare()
+    assert [key for key, payload in received if payload != b"probe"] == [own_step]
+    assert f"anicov/{TEAM}/alive/agent/0" not in alive
 
 
 def test_a_secure_team_runs_to_completion_and_equals_the_engine(tmp_path, profile):

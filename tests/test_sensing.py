@@ -5,10 +5,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.fixed_point import COVERAGE_SCALE
-from model.ground import NO_POSITIONS, Ground, open_ground
-from model.metrics import total_sensing_ability
-from model.sensing import lack_of_coverage, sense_wedge, sensing_ability
+from model.paper.fixed_point import COVERAGE_SCALE
+from model.paper.metrics import total_sensing_ability
+from model.paper.sensing import lack_of_coverage, sensing_ability
+from model.world.ground import NO_POSITIONS, Ground, open_ground
+from model.world.wedge import sense_wedge
 
 OPEN = (open_ground(), NO_POSITIONS, 0)  # the paper's open world: nothing hides anything
 

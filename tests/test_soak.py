@@ -6,14 +6,12 @@ from __future__ import annotations
 import json
 import os
 import signal
-import time
 
 import pytest
 
-from tests.teamrun import anicov, launched_team, processes_of, unique_team, wait_for
+from tests.teamrun import anicov, free_port, launched_team, limit, processes_of, run_progress, unique_team, wait_for
 from tests.test_faults import (
     agent_pid,
-    agents_started,
     assert_every_replica_holds_every_published_delta_once,
     fuzz_a_running_team,
     pid_of,
@@ -28,17 +26,19 @@ def restarted(out, count: int) -> bool:
 
 
 def test_soak_lockstep_paper_run_with_10_percent_loss_and_three_coordinator_kills(tmp_path):
-    team = unique_team()
+    team, port = unique_team(), free_port()
     out = tmp_path / "run"
-    with launched_team(
-        "--n", "4", "--seed", "1", "--drop-rate", "0.10", "--no-record", "--out", str(out), team=team
-    ) as process:
-        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
-        for kill in range(1, 4):
-            time.sleep(3.0)
+    with (
+        launched_team(
+            "--n", "4", "--seed", "1", "--drop-rate", "0.10", "--no-record", "--out", str(out), team=team, port=port
+        ) as process,
+        run_progress(port, team) as progress,
+    ):
+        for kill in range(1, 4):  # a quarter, a half and three quarters into the run's 6,000 or so steps
+            progress.wait_for_step(1500 * kill, process)
             os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
             assert wait_for(lambda kill=kill: restarted(out, kill), timeout=120)
-        stdout, stderr = process.communicate(timeout=1200)
+        stdout, stderr = process.communicate(timeout=limit(1200))
     assert process.returncode == 0, stderr + stdout
     assert "killed and restarted 3 time(s)" in stdout
     engine = anicov("run", "--n", "4", "--seed", "1", "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
@@ -46,40 +46,43 @@ def test_soak_lockstep_paper_run_with_10_percent_loss_and_three_coordinator_kill
     for name in ("trajectory.csv", "summary.json"):
         assert (tmp_path / "engine" / name).read_bytes() == (out / name).read_bytes(), name
     assert_every_replica_holds_every_published_delta_once(out, agents=4)
-    assert wait_for(lambda: processes_of(team) == [], timeout=10)
+    assert wait_for(lambda: processes_of(team) == [], timeout=60)
 
 
 def test_soak_realtime_eight_agents_with_loss_a_dead_agent_and_a_coordinator_kill(tmp_path):
-    team = unique_team()
+    team, port = unique_team(), free_port()
     out = tmp_path / "run"
-    with launched_team(
-        "--n",
-        "8",
-        "--seed",
-        "2",
-        "--clock",
-        "realtime",
-        "--speed",
-        "20",
-        "--drop-rate",
-        "0.10",
-        "--no-record",
-        "--out",
-        str(out),
-        team=team,
-    ) as process:
-        assert wait_for(lambda: agents_started(out / "logs", 8), timeout=120)
-        time.sleep(3.0)
+    with (
+        launched_team(
+            "--n",
+            "8",
+            "--seed",
+            "2",
+            "--clock",
+            "realtime",
+            "--speed",
+            "20",
+            "--drop-rate",
+            "0.10",
+            "--no-record",
+            "--out",
+            str(out),
+            team=team,
+            port=port,
+        ) as process,
+        run_progress(port, team) as progress,
+    ):
+        progress.wait_for_step(600, process)  # 3 s in at speed 20
         os.kill(agent_pid(team, 5), signal.SIGKILL)
-        time.sleep(2.0)
+        progress.wait_for_step(1000, process)  # 2 s later
         os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
-        stdout, stderr = process.communicate(timeout=1200)
+        stdout, stderr = process.communicate(timeout=limit(1200))
     assert process.returncode == 0, stderr + stdout
     assert json.loads((out / "summary.json").read_text())["completed"] is True
     coordinator = json.loads((out / "coordinator_counts.json").read_text())
     survivors = [json.loads((out / "logs" / f"agent-{i}.counts.json").read_text()) for i in range(8) if i != 5]
     assert len({counts["map_digest"] for counts in (coordinator, *survivors)}) == 1
-    assert wait_for(lambda: processes_of(team) == [], timeout=10)
+    assert wait_for(lambda: processes_of(team) == [], timeout=60)
 
 
 def test_soak_fuzz_four_hundred_thousand_payloads(tmp_path):

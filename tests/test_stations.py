@@ -7,11 +7,10 @@ import pytest
 from scipy.optimize import linprog
 from scipy.sparse import csc_matrix
 
-import model.stations as stations_module
-from model.lane_planner import LOOKAHEAD, STARE_DISTANCE, STARE_PERIODS, LanePlanner
-from model.route import FACE_RADIUS, Route, Stop
-from model.scenario import load_scenario
-from model.stations import (
+import model.controllers.anicov.stations as stations_module
+from model.controllers.anicov.lane_planner import LOOKAHEAD, STARE_DISTANCE, STARE_PERIODS, LanePlanner
+from model.controllers.anicov.route import FACE_RADIUS, Route, Stop
+from model.controllers.anicov.stations import (
     BEARINGS,
     SPACINGS_PER_RANGE,
     bearing_sequence,
@@ -23,7 +22,8 @@ from model.stations import (
     whole_periods,
     with_patched_stops,
 )
-from model.touch_ups import simulate_routes
+from model.controllers.anicov.touch_ups import simulate_routes
+from model.scenario import load_scenario
 
 PAPER = Path(__file__).resolve().parents[1] / "scenarios" / "paper.toml"
 STEP = 2.0 * math.pi / BEARINGS

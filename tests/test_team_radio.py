@@ -6,20 +6,21 @@ from __future__ import annotations
 import json
 import os
 import signal
-import time
 
 from logger.replay import summarise_recording
 from tests.teamrun import (
     anicov,
+    free_port,
     launched_team,
     launcher_command,
+    limit,
     processes_of,
     run,
+    run_progress,
     unique_team,
-    wait_for,
     write_scenario,
 )
-from tests.test_faults import agents_started, pid_of
+from tests.test_faults import pid_of
 
 
 def agent_counts(run_dir, agents):
@@ -86,19 +87,22 @@ def assert_bandwidth_is_reported(out, stdout, counts):
 
 
 def test_local_planning_finishes_the_run_after_the_coordinator_is_killed(tmp_path):
-    """Realtime, local planning: the coordinator is SIGKILLed 3 s into the run and not restarted; the
-    robots plan for themselves, end when their replicas are complete, and the logger still records."""
+    """Realtime, local planning: the coordinator is SIGKILLed at step 600 (3 s into the run, of some 1,000
+    steps) and not restarted; the robots plan for themselves, end when their replicas are complete, and the
+    logger still records."""
     config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=4, seed=3, planning="local")
-    team = unique_team()
+    team, port = unique_team(), free_port()
     out = tmp_path / "team"
-    with launched_team(
-        "--config", str(config), "--out", str(out), "--clock", "realtime", "--speed", "20",
-        "--coordinator-restarts", "0", team=team,
-    ) as process:  # fmt: skip
-        assert wait_for(lambda: agents_started(out / "logs", 4), timeout=120)
-        time.sleep(3.0)
+    with (
+        launched_team(
+            "--config", str(config), "--out", str(out), "--clock", "realtime", "--speed", "20",
+            "--coordinator-restarts", "0", team=team, port=port,
+        ) as process,
+        run_progress(port, team) as progress,
+    ):  # fmt: skip
+        progress.wait_for_step(600, process)
         os.kill(pid_of(team, "coordinator"), signal.SIGKILL)
-        stdout, stderr = process.communicate(timeout=400)
+        stdout, stderr = process.communicate(timeout=limit(400))
     assert process.returncode == 0, stderr + stdout
     assert "ended the run on their own" in stdout
     counts = agent_counts(out, 4)

@@ -1,4 +1,4 @@
-"""model.terrain: ROS maps and polygons on the coverage grid, and every way a map can be wrong."""
+"""model.scenario.terrain: ROS maps and polygons on the coverage grid, and every way a map can be wrong."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from model.terrain import (
+from model.scenario.terrain import (
     TerrainError,
     check_polygon,
     coarsen,

@@ -1,4 +1,4 @@
-"""model.touch_ups: the cells the planned routes will leave short, foreseen, and the orbits that finish them."""
+"""model.controllers.anicov.touch_ups: the cells the planned routes will leave short, foreseen, and the orbits that finish them."""
 
 from __future__ import annotations
 
@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from anicov.engine import run_scenario
-from model.lane_planner import LOOKAHEAD, LanePlanner
-from model.metrics import pass_reach
+from model.controllers.anicov.lane_planner import LOOKAHEAD, LanePlanner
+from model.controllers.anicov.route import Route
+from model.controllers.anicov.touch_ups import ORBIT_RADIUS, TouchUp, orbit, orbit_for, simulate_routes, with_touch_ups
+from model.paper.metrics import pass_reach
 from model.parameters import coverage_map_of
-from model.route import Route
 from model.scenario import Scenario
-from model.touch_ups import ORBIT_RADIUS, TouchUp, orbit, orbit_for, simulate_routes, with_touch_ups
 
 SMALL = Scenario().with_overrides(domain=[40.0, 40.0], agents=1, controller="anicov", weave=False, stations=False)
 """Straight passes: the touch-ups' geometry below is the straight pass's (test_weave.py has the weave)."""

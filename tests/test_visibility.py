@@ -1,4 +1,4 @@
-"""model.visibility: walls and teammates hide cells; free space hides nothing."""
+"""model.world.visibility: walls and teammates hide cells; free space hides nothing."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from model.visibility import line_of_sight, segment_crosses_occupied, segment_passes_disk
+from model.world.visibility import line_of_sight, segment_crosses_occupied, segment_passes_disk
 
 NOBODY = np.zeros((0, 2))
 

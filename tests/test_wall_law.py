@@ -1,4 +1,4 @@
-"""model.wall_law: the global law among walls when the objective is near: look at what is left, and go
+"""model.world.wall_law: the global law among walls when the objective is near: look at what is left, and go
 nearer when nothing left is in sight (issue 12's stalls on the field map)."""
 
 from __future__ import annotations
@@ -9,10 +9,10 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from model.ground import Ground
 from model.step import no_look
-from model.visibility import line_of_sight
-from model.wall_law import cell_to_look_at, global_law_among_walls
+from model.world.ground import Ground
+from model.world.visibility import line_of_sight
+from model.world.wall_law import cell_to_look_at, global_law_among_walls
 
 TARGET = 100
 

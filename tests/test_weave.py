@@ -1,4 +1,4 @@
-"""model.weave: the anicov controller's passes, straight or weaving, their coverage profile and rings."""
+"""model.controllers.anicov.weave: the anicov controller's passes, straight or weaving, their coverage profile and rings."""
 
 from __future__ import annotations
 
@@ -7,13 +7,21 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model import lane_planner, weave
-from model.metrics import pass_reach, straight_pass_coverage
-from model.route import Route
-from model.routes import CENTRE_ALLOWANCE_LEADS, best_lane_spacing, spiral_in
+from model.controllers.anicov import lane_planner, weave
+from model.controllers.anicov.route import Route
+from model.controllers.anicov.routes import CENTRE_ALLOWANCE_LEADS, best_lane_spacing, spiral_in
+from model.controllers.anicov.touch_ups import simulate_routes
+from model.controllers.anicov.weave import (
+    MARGIN,
+    WEAVE_CENTRE_LEADS,
+    PassLaw,
+    one_pass_reach,
+    pass_profile,
+    sweep_of,
+    two_pass_spacing,
+)
+from model.paper.metrics import pass_reach, straight_pass_coverage
 from model.scenario import Scenario, ScenarioError, load_scenario
-from model.touch_ups import simulate_routes
-from model.weave import MARGIN, WEAVE_CENTRE_LEADS, PassLaw, one_pass_reach, pass_profile, sweep_of, two_pass_spacing
 
 PAPER = Scenario().with_overrides(controller="anicov", stations=False)  # the spiral's passes weave
 WIDE = load_scenario(Path(__file__).resolve().parent.parent / "scenarios" / "wide.toml").with_overrides(

@@ -1,4 +1,4 @@
-"""model.world: what a scenario's terrain makes of the grid, built once."""
+"""model.world.world: what a scenario's terrain makes of the grid, built once."""
 
 from __future__ import annotations
 
@@ -6,10 +6,10 @@ import cv2
 import numpy as np
 import pytest
 
-from model.fixed_point import COVERAGE_SCALE
+from model.paper.fixed_point import COVERAGE_SCALE
 from model.parameters import coverage_map_of, starting_poses
 from model.scenario import Scenario, load_scenario, validate
-from model.world import team_space, world_of
+from model.world.world import team_space, world_of
 from tests.conftest import ROOT
 
 # Four walls 1 unit thick closing a 6 x 6 room whose inside spans [12, 18] x [12, 18].
@@ -54,7 +54,7 @@ def test_a_pocket_narrower_than_the_robot_is_outside_the_team_space():
     occupied = np.zeros((20, 20), dtype=bool)
     occupied[10, :] = True
     occupied[10, 5] = False  # a one-cell gap: a robot of radius 0.6 does not pass
-    # Issue 11's rule alone: with the safety filter on, its margin s would also count (model.world.plan_radius_of).
+    # Issue 11's rule alone: with the safety filter on, its margin s would also count (model.world.world.plan_radius_of).
     scenario_free = world_of(
         validate({"domain": [20.0, 20.0], "robot_radius": 0.4, "safety": False, "obstacles": _walls(occupied)})
     )

@@ -4,7 +4,13 @@ import numpy as np
 import pytest
 
 from anicov.engine import run_scenario
-from model.zigzag import WaypointPilot, lane_offsets, split_lanes, zigzag_start_poses, zigzag_waypoints
+from model.controllers.zigzag.zigzag import (
+    WaypointPilot,
+    lane_offsets,
+    split_lanes,
+    zigzag_start_poses,
+    zigzag_waypoints,
+)
 
 
 def test_paper_lanes_fig8():
@@ -42,7 +48,7 @@ def test_one_agent_zigzag_reproduces_fig8_time_and_path(paper_scenario):
 
 
 def test_a_path_is_cut_into_stretches_that_join_up():
-    from model.zigzag import path_between
+    from model.paper.polyline import path_between
 
     path = np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 5.0], [0.0, 5.0]])
     first, second = path_between(path, 0.0, 12.5), path_between(path, 12.5, 25.0)
@@ -62,7 +68,7 @@ def test_the_boustrophedon_team_covers_everything_from_random_starts(paper_scena
 def test_each_robot_gets_the_piece_that_keeps_the_teams_transit_least(paper_scenario):
     from itertools import permutations
 
-    from model.zigzag import boustrophedon_pilots
+    from model.controllers.zigzag.zigzag import boustrophedon_pilots
 
     scenario = paper_scenario.with_overrides(controller="boustrophedon", agents=3)
     poses = np.array([[90.0, 90.0, 0.0], [5.0, 5.0, 0.0], [50.0, 50.0, 0.0]])

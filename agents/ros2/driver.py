@@ -38,9 +38,9 @@ from agents.ros2.frames import Pose, ScenarioFrame, compose, invert, scale_into
 from agents.ros2.messages import BadRosMessage, RosPose, decode_pose, encode_velocity
 from agents.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, Ros2Options
 from agents.ros2.transport import Ros2Topics
-from model.dynamics import unicycle_step
+from model.paper.dynamics import unicycle_step
 from model.scenario import Scenario
-from model.terrain import load_occupancy_map
+from model.scenario.terrain import load_occupancy_map
 
 log = logging.getLogger("anicov.ros2")
 

@@ -1,5 +1,5 @@
 """Draws docs/controller/weave_profile.png: one pass's coverage across its course, straight and weaving
-(model.weave.pass_profile, the paper's sensor), and a weaving pass's path with its wedge at a few steps.
+(model.controllers.anicov.weave.pass_profile, the paper's sensor), and a weaving pass's path with its wedge at a few steps.
 
     .venv/bin/python docs/controller/weave_figure.py
 """
@@ -19,8 +19,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from model.scenario import Scenario  # noqa: E402
-from model.weave import (  # noqa: E402
+from model.controllers.anicov.weave import (  # noqa: E402
     WAVELENGTH_PER_RANGE,
     PassLaw,
     flown_course,
@@ -28,6 +27,7 @@ from model.weave import (  # noqa: E402
     sweep_of,
     two_pass_spacing,
 )
+from model.scenario import Scenario  # noqa: E402
 
 AMPLITUDES = (0.0, 0.3, 0.45)
 WEDGE_DRAWN = 3.0

@@ -1,0 +1,60 @@
+"""The paper's planning step, Algorithm 1 (objectives from blobs) then Algorithm 2 (assignment): the planner
+of the paper's controllers, and of every plug-in that brings none of its own.
+
+On a terrain each objective is moved into the team's space and Algorithm 2 takes the lengths of the
+shortest free paths (:func:`model.planning.path_lengths`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from model.paper.assignment import assign_objectives
+from model.paper.objectives import BlobObjectives, fallback_objective, select_objectives
+from model.planning import Plan, TeamPlanner, path_lengths
+from model.scenario import Scenario
+from model.world.reachability import nearest_reachable
+from model.world.world import world_of
+
+
+@dataclass
+class Planner(TeamPlanner):
+    """Algorithm 1 then Algorithm 2, with the blob objectives kept between calls (Alg. 1 reuses them)."""
+
+    scenario: Scenario
+    blobs: BlobObjectives = field(default_factory=BlobObjectives)
+
+    def plan(self, lack: np.ndarray, positions: np.ndarray, members: list[int] | None = None) -> np.ndarray:
+        """Objective (x, y) for every agent (``members``, by id; default all, in id order), shape (N, 2).
+
+        A scenario with fixed ``objectives`` gives each robot its own, Algorithms 1–2 do not run.
+
+        On a terrain Algorithm 1 runs on the same Υ (cells nobody can cover are at Λ* already), each
+        objective is then moved into the team's space (:func:`model.world.reachability.nearest_reachable`)
+        and Algorithm 2 takes the lengths of the shortest free paths to them (:func:`path_lengths`)."""
+        if self.scenario.objectives:
+            ids = range(len(positions)) if members is None else members
+            return np.array([self.scenario.objectives[agent] for agent in ids], dtype=np.float64).reshape(-1, 2)
+        world = world_of(self.scenario)
+        terrain = bool(world.ground.walls)
+        self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range, by_paths=terrain)
+        objectives = self.blobs.positions
+        if len(objectives) == 0:
+            fallback = fallback_objective(lack, positions, self.scenario.cell)
+            if fallback is None:
+                return positions.copy()
+            objectives = fallback[None, :]
+        if not terrain:
+            return objectives[assign_objectives(positions, objectives)]
+        objectives = nearest_reachable(world.reachable, objectives, self.scenario.cell)
+        return objectives[assign_objectives(positions, objectives, path_lengths(world, positions, objectives))]
+
+    def labels(self) -> np.ndarray | None:
+        """The blob labels of the last plan, as the recording keeps them (uint16), or None."""
+        return None if self.blobs.labels is None else self.blobs.labels.astype(np.uint16)
+
+    def record(self, step: int, targets: np.ndarray) -> Plan:
+        """This plan as kept for the recording: members are all agents, in id order."""
+        return (step, tuple(range(len(targets))), targets.copy(), self.blobs.positions.copy(), self.labels())

@@ -1,0 +1,32 @@
+"""anicov's own controller (docs/controller.md): robots stand at stations and turn their camera through
+bearings chosen by a linear programme, hopping between them (``stations = false``: a weaving spiral then
+passes over what is left), steered by a carrot every :data:`route.CARROT_PERIOD`. Its paths know no walls
+or robot bodies yet, and its routes are cut for the whole team at once (no local planning)."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from model.controllers.anicov.lane_planner import LanePlanner
+from model.controllers.anicov.law import anicov_law
+from model.controllers.anicov.route import CARROT_PERIOD
+from model.controllers.interface import Controller, Supports
+from model.planning import TeamPlanner
+from model.scenario import Scenario
+from model.step import LawParameters
+
+
+class AnicovController(Controller):
+    """Stations (or the weaving spiral) planned by :class:`LanePlanner`, flown by pure pursuit."""
+
+    name: ClassVar[str] = "anicov"
+    supports: ClassVar[Supports] = Supports(terrain=False, local_planning=False, team=True)
+
+    def planner(self, scenario: Scenario) -> TeamPlanner:
+        return LanePlanner(scenario)
+
+    def plan_steps(self, scenario: Scenario) -> int:
+        return max(1, round(CARROT_PERIOD / scenario.dt))
+
+    def law(self, scenario: Scenario, target_ticks: int) -> LawParameters:
+        return anicov_law(scenario, target_ticks)

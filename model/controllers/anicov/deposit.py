@@ -1,0 +1,81 @@
+"""What a camera adds to the coverage map (eq. 2-3) from poses the planner chooses: a stare from a station, a
+straight hop between stations; :mod:`model.controllers.anicov.stations`' linear programme is built from them.
+
+Beyond the paper (docs/controller.md). Each is one step of the engine's own sensor
+(:func:`model.world.wedge.sense_wedge_among`, in the open world), so that what the programme counts is what the
+engine would add.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+from scipy.sparse import csc_matrix
+
+from model.paper.coverage_map import CoverageMap, add_window
+from model.scenario import Scenario
+from model.world.ground import open_ground
+from model.world.wedge import sense_wedge_among
+
+
+class Deposit:
+    """The coverage (in Λ*) a camera adds over the scenario's grid, as the engine's sensor adds it."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        self.scenario = scenario
+        self.shape = scenario.grid_shape
+        self.target_ticks = CoverageMap(*self.shape, scenario.cell, scenario.lambda_star).target_ticks
+        self.ground, self.nobody = open_ground(), np.zeros((0, 2))
+        self.blank = np.zeros(self.shape, dtype=np.int64)  # the map the sensor reads Υ from (not written)
+
+    def window(self, x: float, y: float, theta: float) -> tuple[int, int, np.ndarray]:
+        """(row0, col0, ticks) one step of the sensor adds from this pose."""
+        scenario = self.scenario
+        _, _, _, row0, col0, window = sense_wedge_among(
+            self.blank, 1 << 62, x, y, theta, scenario.range, scenario.half_angle,
+            scenario.alpha_max, scenario.dt, scenario.cell, self.ground, self.nobody,
+        )  # fmt: skip
+        return row0, col0, window
+
+    def stare_cells(self, x: float, y: float, theta: float) -> tuple[np.ndarray, np.ndarray]:
+        """One plan period facing ``theta`` from (x, y): (flat indices of the cells it reaches, Λ* added to
+        each). The robot stands still, so every step of the period adds the same window."""
+        row0, col0, window = self.window(x, y, theta)
+        rows, cols = np.nonzero(window)
+        flat = (rows + row0) * self.shape[1] + cols + col0
+        return flat, window[rows, cols] * self.scenario.plan_steps / self.target_ticks
+
+    def stare(self, x: float, y: float, theta: float) -> np.ndarray:
+        """One plan period facing ``theta`` from (x, y), per cell (Λ*)."""
+        flat, added = self.stare_cells(x, y, theta)
+        cells = np.zeros(self.shape[0] * self.shape[1])
+        cells[flat] = added
+        return cells
+
+    def stares(self, stations: np.ndarray, angles: np.ndarray) -> csc_matrix:
+        """Every station's stare at every angle (cells x stations·angles, Λ*), built sparse: a stare reaches
+        a wedge's cells of the domain's."""
+        indices, values, starts = [], [], [0]
+        for x, y in stations:
+            for angle in angles:
+                flat, added = self.stare_cells(float(x), float(y), float(angle))
+                indices.append(flat)
+                values.append(added)
+                starts.append(starts[-1] + len(flat))
+        shape = (self.shape[0] * self.shape[1], len(stations) * len(angles))
+        return csc_matrix((np.concatenate(values), np.concatenate(indices), np.array(starts)), shape=shape)
+
+    def hops(self, stations: np.ndarray) -> np.ndarray:
+        """The hops between consecutive stations flown straight at k_v, per cell (Λ*)."""
+        ticks = np.zeros(self.shape, dtype=np.int64)
+        step = self.scenario.k_v * self.scenario.dt
+        for a, b in itertools.pairwise(stations):
+            heading = math.atan2(b[1] - a[1], b[0] - a[0])
+            steps = round(float(np.linalg.norm(b - a)) / step)
+            for k in range(steps):
+                x, y = a + (b - a) * k / steps
+                row0, col0, window = self.window(float(x), float(y), heading)
+                add_window(ticks, row0, col0, window, 1 << 62)
+        return ticks.ravel() / self.target_ticks

@@ -1,0 +1,273 @@
+"""The safety filter (issue 12): between the coverage law and the robot, the command nearest the law's
+that keeps robots apart and off the walls, from one robot's own view. Rules in docs/safety.md.
+
+Formulation: barrier certificates on a look-ahead point, as the Robotarium's
+(Wang, Ames & Egerstedt, "Safety barrier certificates for collisions-free multirobot systems", IEEE
+T-RO 33(3), 2017; Robotarium rps ``create_uni_barrier_certificate``), in the discrete-time form of
+Agrawal & Sreenath (RSS 2017), with each robot taking half of each pair's constraint (decentralised).
+
+* The point p = c + l·(cos θ, sin θ) ahead of the centre c moves as a single integrator:
+  ṗ = u = v·e + l·ω·e⊥, so z = (v, l·ω) is u in the robot's frame and |u − û| = |z − ẑ|.
+* Over one step with (v, ω) held, p moves by Δ = dt·sinc(ω·dt/2)·R(ω·dt/2)·u; |Δ − u·dt| ≤ ε with
+  ε = u_max·ω_max·dt²/2 (the slack).
+* Robot pair: h = |p_i − p_j| − D, D = 2r + s + 2l (+ how far a teammate's point may have moved since
+  its pose was sent). With n = (p_i − p_j)/|p_i − p_j|, |p'_i − p'_j| ≥ n·(p'_i − p'_j), so if each robot
+  keeps n·Δ_i ≥ −½·γ·h, then h_{k+1} ≥ (1 − γ)·h_k ≥ 0: the points stay D apart, the centres 2r + s.
+  Each robot imposes n·u ≥ (−½·γ·h + ε)/dt on itself.
+* Wall cell (a closed square) or map edge: q its point nearest the centre c, n = (c − q)/|c − q|: the whole
+  cell lies behind the line through q normal to n, so h = n·(c − q) − (r + s) ≥ 0 keeps the disk s off it.
+  A wall does not move, so the centre itself carries this barrier, with the whole of γ:
+  v·dt·(n·e) − |v|·dt·κ ≥ −γ·h, κ = ω_max·dt/2 (the arc's turn off its chord), two half-planes in v.
+* Velocity bounds of the paper: |v| ≤ k_v, |ω| ≤ π·k_ω (eq. 15–16), as four more half-planes.
+* The QP min |z − ẑ|² over them is solved exactly (:mod:`model.safety.barrier_qp`); if it is empty the robot
+  stops (v = ω = 0: Δ = 0 keeps its half of every constraint), as the Robotarium's does.
+
+Deadlock (a robot held still by a teammate for ``STUCK_STEPS`` steps): the standard remedy of a
+rotation bias (the "keep right" rule, Wang et al. 2017, Sec. VI; Grover et al. 2016): the nominal
+velocity is turned by ``KEEP_RIGHT`` to the robot's right until the law's own command passes the filter
+again (resolved) or ``DETOUR_STEPS`` have gone (given up; it may be found again). A rotation of a velocity
+near zero does nothing, and a robot held while it *turns in place* (its law asks the look-ahead point to
+move mostly by turning: |v̂| < l·|ω̂|, as near an objective, where eq. 10 stops it and turns it to look)
+asks for just that: two robots side by side turning toward the same blob swing their points at each
+other and stay frozen. There the priority rule settles it: the robot whose nearest teammate has the
+lower id yields, driving its point straight away from that teammate's at k_v for ``YIELD_STEPS`` steps,
+so the other can turn (the id order of Alg. 2's own tie-breaking; priority-based yielding as in
+Čáp, Novák, Kleiner & Selecký, IEEE T-ASE 12(3), 2015).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from model.paper.geometry import wrap_angle
+from model.safety.barrier_constraints import PARKED, TEAMMATE, SafetyParameters, disabled_safety, safe_velocities
+from model.world.ground import Ground
+
+__all__ = ["PARKED", "TEAMMATE", "SafetyParameters", "disabled_safety", "filter_command", "safe_velocities"]
+
+FILTER_CHANGED = 1  # the command differs from the law's
+KEEPING_RIGHT = 2  # a deadlock's detour is under way (keeping right or yielding)
+NO_SAFE_COMMAND = 4  # the QP was empty: stopped
+STALE_NEIGHBOUR = 8  # a teammate in range sent no pose for max_pose_age: stopped
+DEADLOCK_FOUND = 16  # held by a teammate for STUCK_STEPS: the detour starts
+DEADLOCK_RESOLVED = 32  # the law's command passes again after a detour
+RAN_LATE = 64  # realtime: the control loop fell behind its clock; the robot held still for this step
+POSE_STALE = 128  # a real base sent no pose for its timeout: held still, nothing sensed (agents.ros2)
+
+STUCK_STEPS = 10
+"""Steps a robot may be held by a teammate (moving at under HELD_FRACTION of the law's speed) before
+it is called a deadlock."""
+HELD_FRACTION = 0.25
+WANTS_TO_MOVE = 0.05
+"""A robot held is one whose law asks for more than this fraction of k_v."""
+KEEP_RIGHT = math.radians(60.0)
+DETOUR_STEPS = 100
+"""The most steps one detour lasts before it is given up."""
+YIELD_STEPS = 20
+"""Steps a robot yielding to a lower-id teammate drives away from it (2 time units at dt = 0.1)."""
+
+HELD, DETOUR, YIELDING = 0, 1, 2
+MEMORY_SIZE = 3
+"""A robot's deadlock state (``memory``): steps held so far, steps of the detour under way, and whether
+that detour is a yield (1) or keeping right (0)."""
+
+
+@njit(cache=True)
+def filter_command(
+    v_hat: float,
+    omega_hat: float,
+    me: int,
+    poses: np.ndarray,
+    ages: np.ndarray,
+    kinds: np.ndarray,
+    ground: Ground,
+    cell: float,
+    safety: SafetyParameters,
+    memory: np.ndarray,
+) -> tuple[float, float, int]:
+    """The command robot ``me`` applies, and what the filter did (the flag bits above).
+
+    ``poses`` (N, 3): every robot's last known pose, this one's current; ``ages`` (N,): how old each is
+    (0 in lockstep); ``kinds``: TEAMMATE or PARKED; ``memory`` (MEMORY_SIZE,): the deadlock state, updated
+    in place (the engine and the agent both keep it, so lockstep agrees)."""
+    v, omega, feasible, binding, stale, wall_x, wall_y = safe_velocities(
+        v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
+    )
+    if stale:  # it depends on the poses alone, not on the command
+        memory[HELD] = 0
+        return 0.0, 0.0, STALE_NEIGHBOUR
+    law_omega = omega_hat  # what FILTER_CHANGED compares with, also when the slide turns the nominal
+    pressed = wall_x != 0.0 or wall_y != 0.0
+    if not binding and pressed and abs(v_hat) > 0.01 * safety.v_max and abs(v) < HELD_FRACTION * abs(v_hat):
+        # Pressed on a wall (the law drives into it and the wall stops it): slide along it (see _slide).
+        omega_hat = _slide(poses[me, 2], wall_x, wall_y, safety)
+        v, omega, feasible, binding, _, _, _ = safe_velocities(
+            v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
+        )
+    flags = 0
+    if memory[DETOUR] > 0:  # a detour under way: yielding or keeping right
+        passes = feasible and not _held(v_hat, omega_hat, v, omega, binding, safety)
+        v, omega, feasible, flags = _detour(
+            v_hat, omega_hat, v, omega, feasible, passes, me, poses, ages, kinds, ground, cell, safety, memory
+        )
+    elif binding and _held(v_hat, omega_hat, v if feasible else 0.0, omega if feasible else 0.0, binding, safety):
+        memory[HELD] += 1
+        if memory[HELD] >= STUCK_STEPS:
+            memory[HELD] = 0
+            memory[DETOUR] = 1
+            flags |= DEADLOCK_FOUND
+            turning = abs(v_hat) < safety.lookahead * abs(omega_hat)
+            away_x, away_y = _yield_direction(me, poses, safety)
+            if turning and (away_x != 0.0 or away_y != 0.0):
+                memory[YIELDING] = 1
+                flags |= KEEPING_RIGHT
+                v, omega, feasible = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
+    else:
+        memory[HELD] = 0
+    if not feasible:
+        return 0.0, 0.0, flags | NO_SAFE_COMMAND
+    if abs(v - v_hat) + safety.lookahead * abs(omega - law_omega) > 1e-12 * (1.0 + abs(v_hat)):
+        flags |= FILTER_CHANGED
+    return v, omega, flags
+
+
+@njit(cache=True)
+def _detour(
+    v_hat: float,
+    omega_hat: float,
+    v: float,
+    omega: float,
+    feasible: bool,
+    passes: bool,
+    me: int,
+    poses: np.ndarray,
+    ages: np.ndarray,
+    kinds: np.ndarray,
+    ground: Ground,
+    cell: float,
+    safety: SafetyParameters,
+    memory: np.ndarray,
+) -> tuple[float, float, bool, int]:
+    """One step of a deadlock's detour: (v, ω, feasible, flags). Yielding drives away from the nearest
+    (lower-id) teammate for YIELD_STEPS in all; keeping right ends once the law's command ``passes`` the
+    filter, or after DETOUR_STEPS."""
+    if memory[YIELDING] == 1:
+        away_x, away_y = _yield_direction(me, poses, safety)
+        if memory[DETOUR] >= YIELD_STEPS or (away_x == 0.0 and away_y == 0.0):
+            memory[DETOUR] = memory[YIELDING] = 0
+            return v, omega, feasible, DEADLOCK_RESOLVED if passes else 0
+        memory[DETOUR] += 1
+        v, omega, feasible = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
+        return v, omega, feasible, KEEPING_RIGHT
+    if passes:
+        memory[DETOUR] = 0
+        return v, omega, feasible, DEADLOCK_RESOLVED
+    if memory[DETOUR] >= DETOUR_STEPS:
+        memory[DETOUR] = 0
+        return v, omega, feasible, 0
+    memory[DETOUR] += 1
+    v, omega, feasible, _, _, _, _ = safe_velocities(
+        v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, -KEEP_RIGHT
+    )
+    return v, omega, feasible, KEEPING_RIGHT
+
+
+@njit(cache=True)
+def _yield_direction(me: int, poses: np.ndarray, safety: SafetyParameters) -> tuple[float, float]:
+    """The unit vector from the nearest teammate's look-ahead point (within safety_range, centre to centre)
+    to this robot's, when that teammate has the lower id (this robot yields); else (0, 0)."""
+    ahead = safety.lookahead
+    x, y, theta = poses[me, 0], poses[me, 1], poses[me, 2]
+    px, py = x + ahead * math.cos(theta), y + ahead * math.sin(theta)
+    nearest, best, away_x, away_y = -1, math.inf, 0.0, 0.0
+    for j in range(poses.shape[0]):
+        if j == me or not math.isfinite(poses[j, 0]):
+            continue
+        if math.hypot(x - poses[j, 0], y - poses[j, 1]) > safety.reach:
+            continue
+        dx = px - poses[j, 0] - ahead * math.cos(poses[j, 2])
+        dy = py - poses[j, 1] - ahead * math.sin(poses[j, 2])
+        distance = math.hypot(dx, dy)
+        if distance < best:
+            nearest, best = j, distance
+            away_x, away_y = (dx / distance, dy / distance) if distance > 0.0 else (-math.cos(theta), -math.sin(theta))
+    if nearest < 0 or nearest > me:
+        return 0.0, 0.0
+    return away_x, away_y
+
+
+@njit(cache=True)
+def _drive_along(
+    away_x: float,
+    away_y: float,
+    me: int,
+    poses: np.ndarray,
+    ages: np.ndarray,
+    kinds: np.ndarray,
+    ground: Ground,
+    cell: float,
+    safety: SafetyParameters,
+) -> tuple[float, float, bool]:
+    """The safe command nearest moving the look-ahead point along (away_x, away_y) at k_v: the nominal
+    z = k_v·(n·e, n·e⊥) in the robot's frame, through the same QP."""
+    theta = poses[me, 2]
+    cos_t, sin_t = math.cos(theta), math.sin(theta)
+    v_hat = safety.v_max * (away_x * cos_t + away_y * sin_t)
+    omega_hat = safety.v_max * (-away_x * sin_t + away_y * cos_t) / safety.lookahead
+    v, omega, feasible, _, _, _, _ = safe_velocities(
+        v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
+    )
+    return v, omega, feasible
+
+
+SLIDE_AWAY = math.radians(20.0)
+"""How far from the wall's tangent a robot sliding along it heads: at the barrier (h = 0) the filter lets a
+robot move only if it heads away from the wall by more than asin(κ) (9° at the paper's gains)."""
+
+
+@njit(cache=True)
+def _slide(theta: float, wall_x: float, wall_y: float, safety: SafetyParameters) -> float:
+    """An ω that slides a robot pressed on a wall along it (the wall-following rule of bug algorithms):
+    toward the wall's tangent nearest its heading, SLIDE_AWAY off the wall; head-on, to the right. The
+    centre barrier holds v alone, so a robot heading into a wall whose law does not turn it would stand
+    there for ever. From the heading, not the law's wish: that one may point back into the wall."""
+    gain = safety.omega_max / math.pi  # k_ω
+    along = math.cos(theta) * wall_x + math.sin(theta) * wall_y
+    tx, ty = math.cos(theta) - along * wall_x, math.sin(theta) - along * wall_y
+    if math.hypot(tx, ty) < 1e-6:
+        tx, ty = -wall_y, wall_x  # straight at it: to the right (n points back at the robot)
+    side = math.atan2(ty, tx)
+    heading = side + SLIDE_AWAY * math.sin(wrap_angle(math.atan2(wall_y, wall_x) - side))
+    return gain * wrap_angle(heading - theta)
+
+
+@njit(cache=True)
+def _held(v_hat: float, omega_hat: float, v: float, omega: float, binding: bool, safety: SafetyParameters) -> bool:
+    """A teammate's constraint binds and the robot moves at under HELD_FRACTION of what its law asks."""
+    ahead = safety.lookahead
+    asked = math.hypot(v_hat, ahead * omega_hat)
+    return binding and asked > WANTS_TO_MOVE * safety.v_max and math.hypot(v, ahead * omega) < HELD_FRACTION * asked
+
+
+def load_kernels(safety: SafetyParameters, ground: Ground, cell: float, agents: int) -> None:
+    """Have numba load the filter now, with the real argument types, on scratch state (see
+    model.step.load_kernels)."""
+    if not safety.enabled:
+        return
+    poses = np.zeros((agents, 3))
+    poses[:, 0] = np.arange(agents) * 1e3  # nobody near anybody
+    filter_command(
+        0.0,
+        0.0,
+        0,
+        poses,
+        np.zeros(agents),
+        np.zeros(agents, dtype=np.int64),
+        ground,
+        cell,
+        safety,
+        np.zeros(MEMORY_SIZE, dtype=np.int64),
+    )

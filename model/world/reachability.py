@@ -1,0 +1,81 @@
+"""What a team can cover at all: cells that no reachable pose can see (issue 11, "what complete means").
+
+A pose is reachable when its cell is passable (:func:`model.world.geodesic.passable_cells`) and connected to
+a robot's start through passable cells (the 8-connected graph of :mod:`model.world.geodesic`, no corner
+cutting). A free cell is coverable when its centre lies closer than R to the centre of a reachable
+cell with a clear line of sight (:func:`model.world.visibility.segment_crosses_occupied`): the robot can turn
+its camera any way, and eq. 2 gives α = 0 at r = R. Occupied cells and the rest of the free cells
+(an enclosed room, a pocket narrower than the robot) are left out of e_D and of completion.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from scipy.sparse.csgraph import connected_components
+
+from model.world.geodesic import grid_graph
+from model.world.visibility import segment_crosses_occupied
+
+
+def reachable_cells(passable: np.ndarray, starts: list[tuple[int, int]], cell: float) -> np.ndarray:
+    """Passable cells connected to any of the start cells."""
+    rows, cols = passable.shape
+    _, labels = connected_components(grid_graph(passable, cell), directed=False)
+    labels = labels.reshape(rows, cols)
+    start_labels = {labels[row, col] for row, col in starts if passable[row, col]}
+    return np.isin(labels, list(start_labels)) & passable
+
+
+@njit(cache=True)
+def _seen_from(occupied: np.ndarray, reachable: np.ndarray, sensing_range: float, cell: float) -> np.ndarray:
+    """Free cells within R of a reachable cell's centre in clear sight. A reachable cell sees itself;
+    any other free cell looks for one reachable centre, stopping at the first (most cells are near one)."""
+    rows, cols = occupied.shape
+    seen = reachable.copy()
+    span = math.ceil(sensing_range / cell)
+    for row in range(rows):
+        for col in range(cols):
+            if seen[row, col] or occupied[row, col]:
+                continue
+            tx, ty = (col + 0.5) * cell, (row + 0.5) * cell
+            found = False
+            for r in range(max(row - span, 0), min(row + span + 1, rows)):
+                for c in range(max(col - span, 0), min(col + span + 1, cols)):
+                    if not reachable[r, c]:
+                        continue
+                    x, y = (c + 0.5) * cell, (r + 0.5) * cell
+                    if math.hypot(tx - x, ty - y) >= sensing_range:
+                        continue
+                    if not segment_crosses_occupied(occupied, x, y, tx, ty, cell):
+                        found = True
+                        break
+                if found:
+                    break
+            seen[row, col] = found
+    return seen
+
+
+def coverable_cells(
+    occupied: np.ndarray, passable: np.ndarray, starts: list[tuple[int, int]], sensing_range: float, cell: float
+) -> np.ndarray:
+    """Free cells some reachable pose can see (see the module's docstring)."""
+    return _seen_from(occupied, reachable_cells(passable, starts, cell), sensing_range, cell)
+
+
+def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) -> np.ndarray:
+    """Each point (K, 2) moved to the centre of the nearest reachable cell, unless its own cell is
+    reachable (then it stays as it is): an objective must lie where a robot can go."""
+    rows, cols = reachable.shape
+    cells = np.argwhere(reachable)
+    if len(cells) == 0:
+        raise ValueError("no reachable cell: nowhere to send the robots")
+    centres = (cells[:, ::-1] + 0.5) * cell  # (x, y) of each reachable cell
+    moved = np.array(points, dtype=np.float64, copy=True).reshape(-1, 2)
+    for k, (x, y) in enumerate(moved):
+        row, col = min(max(int(y // cell), 0), rows - 1), min(max(int(x // cell), 0), cols - 1)
+        if not reachable[row, col]:
+            moved[k] = centres[int(np.argmin(np.hypot(centres[:, 0] - x, centres[:, 1] - y)))]
+    return moved

@@ -1,0 +1,188 @@
+"""The world a team covers, built once per scenario: walls, where a robot can go, what it can see.
+
+- ``occupied``: the map on the coverage grid (:func:`model.scenario.terrain.map_on_grid`) or'd with the
+  polygons (:func:`model.scenario.terrain.polygons_on_grid`).
+- ``passable``: centres that hold the robot's disk with PLANNING_MARGIN to spare (:func:`model.world.geodesic.passable_cells`).
+- ``reachable``: the team's space, the largest 8-connected component of passable cells (lowest
+  cell index on a tie). Every robot starts there (:func:`model.parameters.free_initial_poses`), so
+  it is where any robot can go.
+- ``coverable``: free cells some reachable pose can see (:mod:`model.world.reachability`). The others,
+  occupied or not, start at Λ* in every replica (Υ = 0): Algorithm 1 never sees them, and e_D and
+  completion count only coverable cells.
+- ``targets``: Λ*(x) per cell in ticks, from the priority map when there is one.
+
+In the paper's open world (no map, no polygon, point robots) every cell is passable, reachable and
+coverable and nothing here changes a run.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+
+from model.paper.fixed_point import COVERAGE_SCALE
+from model.scenario import Scenario
+from model.scenario.terrain import TerrainError, file_sha256, load_occupancy_map, map_on_grid, polygons_on_grid
+from model.world.geodesic import distance_fields, grid_graph, passable_cells
+from model.world.ground import PLANNING_MARGIN, Ground
+from model.world.reachability import coverable_cells
+
+
+@dataclass(frozen=True, eq=False)
+class World:
+    """See the module's docstring."""
+
+    scenario: Scenario
+    occupied: np.ndarray
+    passable: np.ndarray
+    reachable: np.ndarray
+    coverable: np.ndarray
+    targets: np.ndarray  # int64 ticks: Λ*(x)
+    map_sha256: str
+    priority_sha256: str
+
+    @property
+    def open(self) -> bool:
+        """The paper's world: nothing to test, every run exactly as before terrain existed."""
+        return not self.scenario.has_terrain
+
+    @functools.cached_property
+    def ground(self) -> Ground:
+        """Built once: the engine, the planner and the agent read it every step or plan."""
+        scenario = self.scenario
+        walls = bool(self.occupied.any())
+        occlusion = scenario.occlusion and (bool(self.occupied.any()) or scenario.robot_radius > 0.0)
+        lookahead = max(1, math.ceil(scenario.range / scenario.cell))
+        return Ground(
+            self.occupied,
+            self.passable,
+            scenario.robot_radius,
+            plan_radius_of(scenario),
+            wall_clearance_of(scenario),
+            bool(scenario.map),
+            walls,
+            occlusion,
+            lookahead,
+        )
+
+    @property
+    def unreachable_cells(self) -> int:
+        """Free cells that no reachable pose can see: left out of e_D and of completion."""
+        return int((~self.occupied & ~self.coverable).sum())
+
+    @property
+    def coverable_area(self) -> float:
+        return float(self.coverable.sum()) * self.scenario.cell**2
+
+    def head_start(self, target_ticks: int) -> np.ndarray:
+        """Ticks every replica starts with: Λ* on cells nobody can cover, and Λ*_max − Λ*(x) on the
+        rest (a priority map's lower targets as a head start on one common target)."""
+        return np.where(self.coverable, target_ticks - self.targets, target_ticks).astype(np.int64)
+
+    def field(self, x: float, y: float) -> np.ndarray:
+        """Geodesic distance to the cell of (x, y) from every cell (:func:`model.world.geodesic.distance_fields`)."""
+        rows, cols = self.occupied.shape
+        cell = self.scenario.cell
+        row, col = min(max(math.floor(y / cell), 0), rows - 1), min(max(math.floor(x / cell), 0), cols - 1)
+        return self._field(row, col)
+
+    @functools.lru_cache(maxsize=256)  # noqa: B019 - one World per scenario, kept for the process's life
+    def _field(self, row: int, col: int) -> np.ndarray:
+        field = distance_fields(self.passable, [(row, col)], self.scenario.cell, self._graph)[0]
+        return field
+
+    @functools.cached_property
+    def _graph(self) -> csr_matrix:
+        return grid_graph(self.passable, self.scenario.cell).tocsr()
+
+    def summary(self) -> dict[str, object]:
+        """What summary.json reports of the terrain."""
+        report: dict[str, object] = {
+            "unreachable_cells": self.unreachable_cells,
+            "coverable_cells": int(self.coverable.sum()),
+            "occupied_cells": int(self.occupied.sum()),
+        }
+        if self.map_sha256:
+            report["map_sha256"] = self.map_sha256
+        if self.priority_sha256:
+            report["priority_sha256"] = self.priority_sha256
+        return report
+
+
+def plan_radius_of(scenario: Scenario) -> float:
+    """The robot's radius plus the planning margin: what passable cells and straight drives keep free.
+    With the safety filter on, its margin too: the filter keeps the disk s off every wall (model.safety.safety),
+    so a path nearer a wall than that would be one the filter stops the robot on."""
+    return wall_clearance_of(scenario) + PLANNING_MARGIN * scenario.cell
+
+
+def wall_clearance_of(scenario: Scenario) -> float:
+    """How near a wall the robot's centre comes: r, plus the safety margin when the filter is on."""
+    return scenario.robot_radius + (scenario.safety_margin if scenario.filters else 0.0)
+
+
+def team_space(passable: np.ndarray, cell: float) -> np.ndarray:
+    """The largest 8-connected component of passable cells (see the module's docstring)."""
+    if not passable.any():
+        return passable.copy()
+    _, labels = connected_components(grid_graph(passable, cell), directed=False)
+    labels = labels.reshape(passable.shape)
+    sizes = np.bincount(labels[passable])
+    return passable & (labels == int(np.argmax(sizes)))
+
+
+def _priority_ticks(scenario: Scenario, shape: tuple[int, int]) -> tuple[np.ndarray, str]:
+    high = round(scenario.lambda_star * COVERAGE_SCALE)
+    if not scenario.priority_map:
+        return np.full(shape, high, dtype=np.int64), ""
+    image = cv2.imread(scenario.priority_map, cv2.IMREAD_GRAYSCALE)
+    if image is None or image.size == 0:
+        raise TerrainError(f"scenario key 'lambda_star': {scenario.priority_map} is not a PGM or PNG image")
+    rows, cols = shape
+    grey = cv2.resize(np.flipud(image), (cols, rows), interpolation=cv2.INTER_AREA).astype(np.float64) / 255.0
+    low = round(scenario.lambda_star_min * COVERAGE_SCALE)
+    return np.rint(low + grey * (high - low)).astype(np.int64), file_sha256(Path(scenario.priority_map))
+
+
+def _occupied(scenario: Scenario) -> tuple[np.ndarray, str]:
+    rows, cols = scenario.grid_shape
+    occupied = np.zeros((rows, cols), dtype=bool)
+    sha = ""
+    if scenario.map:
+        occupancy_map = load_occupancy_map(scenario.map)
+        occupied |= map_on_grid(occupancy_map, scenario.cell)
+        sha = occupancy_map.sha256
+    if scenario.obstacles:
+        polygons = [np.array(polygon, dtype=np.float64) for polygon in scenario.obstacles]
+        occupied |= polygons_on_grid(polygons, rows, cols, scenario.cell)
+    return occupied, sha
+
+
+@functools.lru_cache(maxsize=8)
+def world_of(scenario: Scenario) -> World:
+    """The scenario's world, built once per process (it is pure: same scenario, same world).
+    Raises TerrainError when no robot fits anywhere."""
+    shape = scenario.grid_shape
+    targets, priority_sha = _priority_ticks(scenario, shape)
+    if not scenario.has_terrain:
+        everywhere = np.ones(shape, dtype=bool)
+        return World(scenario, ~everywhere, everywhere, everywhere, everywhere, targets, "", priority_sha)
+    occupied, map_sha = _occupied(scenario)
+    where = f"the map {scenario.map}" if scenario.map else "the domain"
+    if occupied.all():
+        raise TerrainError(f"{where} has no free cell")
+    bounded = bool(scenario.map)
+    passable = passable_cells(occupied, plan_radius_of(scenario), scenario.cell, bounded)
+    reachable = team_space(passable, scenario.cell)
+    if not reachable.any():
+        raise TerrainError(f"{where}: no free place holds a robot of radius {scenario.robot_radius}")
+    start = tuple(int(v) for v in np.argwhere(reachable)[0])
+    coverable = coverable_cells(occupied, passable, [start], scenario.range, scenario.cell)
+    return World(scenario, occupied, passable, reachable, coverable, targets, map_sha, priority_sha)
