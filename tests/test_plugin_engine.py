@@ -10,23 +10,8 @@ import pytest
 from anicov.engine import run_scenario
 from model.controllers import Controller, RobotView
 from model.controllers.plugin_step import PluginCommandError
-from model.paper.control import combined_law, global_law, local_law
 from model.scenario import validate
 from tests.teamrun import ROOT
-
-
-class PaperInPython(Controller):
-    """eq. 7–16 from the paper's own functions, called from Python on the objective Algorithms 1–2 give."""
-
-    name = "paper-in-python"
-
-    def command(self, view: RobotView) -> tuple[float, float]:
-        s = view.scenario
-        u_loc, theta_loc = local_law(view.e_omega, view.w_left, view.w_right, view.theta, s.half_angle)
-        u_glo, theta_glo = global_law(view.x, view.y, view.objective_x, view.objective_y, s.range, False)
-        return combined_law(
-            view.theta, view.e_omega, u_loc, theta_loc, u_glo, theta_glo, s.beta, s.k_v, s.k_omega, False
-        )
 
 
 class FailsAtStep(Controller):
@@ -44,7 +29,7 @@ def scenario_with(controller: str, **keys):
 
 def test_the_papers_law_as_a_plug_in_gives_the_compiled_run_exactly():
     compiled = run_scenario(scenario_with("paper"))
-    plugin = run_scenario(scenario_with("tests.test_plugin_engine:PaperInPython"))
+    plugin = run_scenario(scenario_with(f"{ROOT / 'examples' / 'paper_in_python.py'}:PaperInPython"))
     assert compiled.completed and plugin.completed
     assert plugin.steps == compiled.steps
     assert np.array_equal(plugin.trace, compiled.trace)
@@ -57,6 +42,9 @@ def test_the_example_controller_from_outside_the_package_completes():
     assert result.completed and result.final_lack.max() == 0
     speeds = np.abs(result.trace[:-1, :, 3])
     assert speeds.max() <= scenario.k_v and speeds.sum() > 0
+    # It keeps each robot's target between steps; a second run in the same process (a sweep's worker) gets a
+    # new controller, so nothing of the first run leaks into it.
+    assert np.array_equal(run_scenario(scenario).trace, result.trace)
 
 
 def test_a_plug_in_that_fails_mid_run_stops_it_naming_the_controller_the_robot_and_the_step():

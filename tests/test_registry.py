@@ -10,7 +10,7 @@ import textwrap
 import pytest
 
 from model.controllers import BUILT_IN, Controller, ControllerError, canonical_name, controller_of
-from model.controllers.registry import ENTRY_POINT_GROUP, _instance, controller_class
+from model.controllers.registry import ENTRY_POINT_GROUP, controller_class
 from model.scenario import ScenarioError, validate
 
 GOOD = """
@@ -46,7 +46,6 @@ def plugin_dir(tmp_path, monkeypatch):
     yield tmp_path, name
     sys.modules.pop(name, None)
     controller_class.cache_clear()
-    _instance.cache_clear()
 
 
 def test_every_built_in_name_loads_its_controller_and_best_is_anicov():

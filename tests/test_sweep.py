@@ -162,3 +162,21 @@ def test_a_plot_of_any_figure_against_any_key(tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     with pytest.raises(ScenarioError, match="--y: expected a column"):
         plot_sweep(tmp_path / "out", "agents", "speed", None, tmp_path / "q.png")
+
+
+def test_a_plug_in_controller_runs_in_a_sweep_its_file_relative_to_the_sweep_file(tmp_path):
+    """The worked example (examples/) beside the built-in controllers, named relative to the sweep file as the
+    base scenario is; its rows name it by its absolute path, and the controller table by its file."""
+    from anicov.controller_table import controller_table
+
+    example = os.path.relpath(ROOT / "examples" / "nearest_uncovered.py", tmp_path)
+    text = SMALL.replace('["paper", "zigzag"]', f'["paper", "zigzag", "{example}:NearestUncovered"]')
+    sweep = load_sweep(write_sweep(tmp_path, seeds=1, text=text))
+    assert run_sweep(sweep, tmp_path / "out", workers=1, progress=False) == (0, 6)
+    rows = rows_of(tmp_path / "out")
+    mine = [row for row in rows if row["controller"].endswith("nearest_uncovered.py:NearestUncovered")]
+    assert len(mine) == 2 and all(row["completed"] == "True" for row in mine)
+    assert mine[0]["controller"] == f"{ROOT / 'examples' / 'nearest_uncovered.py'}:NearestUncovered"
+    table = controller_table(tmp_path / "out", challenger="nearest_uncovered.py:NearestUncovered")
+    assert "| N | paper t/t* | zigzag t/t* | nearest_uncovered.py:NearestUncovered t/t* |" in table
+    assert "nearest_uncovered.py:NearestUncovered vs best other" in table

@@ -63,13 +63,14 @@ def canonical_name(name: str, base: Path | None = None) -> str:
     if _is_file_path(name):
         path, _, attribute = name.rpartition(":")
         name = f"{((base or Path.cwd()) / path).resolve()}:{attribute}"
-    _instance(name)  # loads it, and makes one: a constructor that raises is found here too
+    _new(name)  # loads it, and makes one: a constructor that raises is found here too
     return name
 
 
 def controller_of(scenario: Scenario) -> Controller:
-    """The scenario's controller (one instance per process and name)."""
-    return _instance(scenario.controller)
+    """A new instance of the scenario's controller: one per run, so that what a controller keeps between
+    steps (a plug-in may) never leaks from one run of a process (a sweep's worker) into the next."""
+    return _new(scenario.controller)
 
 
 def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParameters:
@@ -109,8 +110,7 @@ def _names_supporting(feature: str) -> list[str]:
     return [name for name, controller in BUILT_IN.items() if getattr(controller.supports, feature)]
 
 
-@functools.lru_cache(maxsize=32)
-def _instance(name: str) -> Controller:
+def _new(name: str) -> Controller:
     controller = controller_class(name)
     try:
         return controller()
