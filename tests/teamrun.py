@@ -155,18 +155,22 @@ def run_progress(port: int, team: str) -> Iterator[RunProgress]:
 
 
 PARKED = """
+import json
 import sys
 from pathlib import Path
 
-for module in sys.argv[2].split(","):
+preload, argv = json.loads(Path(sys.argv[2]).read_text())
+for module in preload:
     __import__(module)
 from anicov.cli import main
 
 Path(sys.argv[1]).write_text("parked")
 if sys.stdin.readline() != "go\\n":
     sys.exit(0)
-sys.exit(main(sys.argv[3:]))
+sys.exit(main(argv))
 """
+"""A parked process's code; its arguments are in a file, so that its command line is not taken for the
+team process it will become (tests find those by their command lines: pgrep)."""
 
 
 @dataclass
@@ -202,10 +206,11 @@ class Parked:
 def parked(args: list[str], preload: list[str], folder: Path, name: str) -> Iterator[Parked]:
     """``anicov ARGS`` parked (see :class:`Parked`) until it is ready; its output in ``folder/name.log``;
     killed if still running at the end of the block."""
-    ready_file, log = folder / f"{name}.parked", folder / f"{name}.log"
+    ready_file, log, arguments = folder / f"{name}.parked", folder / f"{name}.log", folder / f"{name}.args.json"
+    arguments.write_text(json.dumps([preload, args]))
     with open(log, "w") as output:
         process = subprocess.Popen(
-            [sys.executable, "-c", PARKED, str(ready_file), ",".join(preload), *args],
+            [sys.executable, "-c", PARKED, str(ready_file), str(arguments)],
             cwd=ROOT,
             stdin=subprocess.PIPE,
             stdout=output,
