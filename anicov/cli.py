@@ -14,7 +14,7 @@ from agents import command as agent_command
 from coordinator import command as coordinator_command
 from logger import command as logger_command
 from model.scenario import ScenarioError
-from runtime.arguments import add_scenario_arguments, scenario_from_arguments
+from runtime.arguments import add_scenario_arguments, note_map_fit, scenario_from_arguments
 from runtime.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, EXIT_USAGE
 
 
@@ -25,6 +25,7 @@ def command_run(args: argparse.Namespace) -> int:
     from runtime.rundir import format_summary, write_run_directory
 
     scenario = scenario_from_arguments(args)
+    note_map_fit(scenario)
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 from agents.command import add_deltas_argument
 from anicov.ros2_team import add_ros2_team_arguments, check_ros2_team, ros2_agent_flags, test_base_commands
 from model.scenario import Scenario
-from runtime.arguments import add_team_arguments, scenario_from_arguments
+from runtime.arguments import add_team_arguments, note_map_fit, scenario_from_arguments
 from runtime.lifecycle import (
     EXIT_FAILED,
     EXIT_INCOMPLETE,
@@ -224,6 +224,7 @@ def main(argv: list[str] | None = None) -> int:
     speed_given, args.speed = args.speed is not None, 10.0 if args.speed is None else args.speed
     try:
         scenario = scenario_from_arguments(args)
+        note_map_fit(scenario)
         check_ros2_team(args, scenario, speed_given)  # settles the clock too
         router_config_file = apply_secure_profile(args, scenario.agents)
     except ValueError as error:  # ScenarioError, or a --secure profile that does not fit

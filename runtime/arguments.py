@@ -8,10 +8,12 @@ each other.
 from __future__ import annotations
 
 import argparse
+import sys
 
 from model.controllers import choices, controller_of
 from model.parameters import starting_poses
 from model.scenario import PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
+from model.world.world import map_note_of
 
 CLOCKS = ("lockstep", "realtime")
 
@@ -90,6 +92,13 @@ def scenario_from_arguments(args: argparse.Namespace) -> Scenario:
         check_no_coordinator(scenario, getattr(args, "clock", None))
     check_world(scenario)
     return scenario
+
+
+def note_map_fit(scenario: Scenario) -> None:
+    """Say on the console what fitting the scenario's map to its cells changed (model.scenario.map_fit)."""
+    note = map_note_of(scenario)
+    if note:
+        print(f"note: {note}", file=sys.stderr)
 
 
 def check_no_coordinator(scenario: Scenario, clock: str | None) -> None:

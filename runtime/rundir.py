@@ -15,7 +15,7 @@ from model.paper.fixed_point import COVERAGE_SCALE
 from model.paper.metrics import optimum_time, total_sensing_ability
 from model.run import RunResult
 from model.safety.safety_record import safety_figures
-from model.world.world import World, world_of
+from model.world.world import World, map_corner_of, world_of
 
 TRAJECTORY_HEADER = "t,agent,x,y,theta,v,omega"
 
@@ -26,14 +26,20 @@ def step_time(step: int, dt: float) -> float:
 
 
 def write_trajectory(result: RunResult, path: Path) -> None:
-    """One row per agent per step (pose at the start, (v, ω) during), then the final poses with v = ω = 0."""
+    """One row per agent per step (pose at the start, (v, ω) during), then the final poses with v = ω = 0.
+    On a map, positions are in the map's own frame (what RViz shows): the model's, plus where its (0, 0)
+    lies (:func:`model.world.world.map_corner_of`; nothing is added when it is the map frame's origin)."""
     dt = result.scenario.dt
+    corner_x, corner_y = map_corner_of(result.scenario)
+    shifted = (corner_x, corner_y) != (0.0, 0.0)
     lines = [TRAJECTORY_HEADER]
     for step, rows in enumerate(result.trace):
         t = repr(step_time(step, dt))
         for agent, (x, y, theta, v, omega, _) in enumerate(rows.tolist()):
             if x != x:  # NaN: a realtime run that never heard this agent's state for this step
                 continue
+            if shifted:
+                x, y = x + corner_x, y + corner_y
             lines.append(f"{t},{agent},{x!r},{y!r},{theta!r},{v!r},{omega!r}")
     path.write_text("\n".join(lines) + "\n", encoding="ascii")
 

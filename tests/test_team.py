@@ -215,3 +215,21 @@ def test_a_plug_in_that_fails_mid_run_is_reported_with_its_name_and_the_team_car
     log = (tmp_path / "team" / "logs" / "agent-1.log").read_text()
     assert "NaNAtTwenty', robot 1, step 20: command() returned (v, omega) = (nan, 0.0)" in log
     assert processes_of(team) == []
+
+
+def test_a_team_on_a_map_saved_with_an_unknown_border_equals_the_engine_in_the_maps_frame(tmp_path):
+    """A map_saver-like map (tests/test_map_fit.py: 286 × 423 pixels of 0.05 m, origin not (0, 0), a room in a
+    wide unknown border) at a TurtleBot3 Burger's units: cropped and padded alike in every process, its
+    trajectory.csv in the map's frame, lockstep over Zenoh equal to the engine byte for byte."""
+    from tests.test_map_fit import scenario_on_saved_map
+
+    scenario_on_saved_map(tmp_path)
+    config = tmp_path / "s.toml"
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+    assert engine.returncode == 0, engine.stderr
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record"))
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "unknown border cropped" in launched.stderr
+    assert_same_run(tmp_path / "engine", tmp_path / "team")
+    corner = json.loads((tmp_path / "team" / "summary.json").read_text())["terrain"]["map_corner"]
+    assert corner[0] < -6.0 and corner[1] < -2.0  # the map's own frame, not the model's

@@ -40,7 +40,7 @@ from agents.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, Ros2Options
 from agents.ros2.transport import Ros2Topics
 from model.paper.dynamics import unicycle_step
 from model.scenario import Scenario
-from model.scenario.terrain import load_occupancy_map
+from model.world.world import map_corner_of
 
 log = logging.getLogger("anicov.ros2")
 
@@ -53,11 +53,12 @@ ODOMETRY_HISTORY = 256
 
 
 def frame_of(scenario: Scenario, options: Ros2Options) -> ScenarioFrame:
-    """The scenario in the robot's map frame: its (0, 0) at ``origin`` if given, else at the scenario map's
-    origin (the same Nav2 map: the frames then agree), else at the map frame's (0, 0); its units."""
+    """The scenario in the robot's map frame: its (0, 0) at ``origin`` if given, else where the scenario's map
+    puts it (the same Nav2 map: the frames then agree; :func:`model.world.world.map_corner_of`, the map's
+    origin when no unknown border was cropped), else at the map frame's (0, 0); its units."""
     origin = options.origin
     if origin is None:
-        origin = load_occupancy_map(scenario.map).origin if scenario.map else (0.0, 0.0)
+        origin = map_corner_of(scenario)
     return ScenarioFrame(origin, scenario.metres_per_unit, scenario.seconds_per_unit)
 
 

@@ -40,11 +40,12 @@ class TerrainError(ValueError):
 class OccupancyMap:
     """A map as read: one bool per pixel (row 0 at the bottom), its resolution and where it lies."""
 
-    occupied: np.ndarray  # bool (height_px, width_px), row 0 = lowest y
+    occupied: np.ndarray  # bool (height_px, width_px), row 0 = lowest y: occupied or unknown
     resolution: float  # domain units per pixel
     origin: tuple[float, float]  # world (x, y) of the lower-left corner of the lower-left pixel
     path: Path
     sha256: str  # of the YAML file and of the image, so either changing shows
+    known: np.ndarray | None = None  # bool like ``occupied``: occupied or free (not unknown); None: every pixel
 
     @property
     def extent(self) -> tuple[float, float]:
@@ -120,7 +121,8 @@ def load_occupancy_map(path: str | Path) -> OccupancyMap:
     free = occupancy < free_thresh
     # Unknown (between the thresholds) is not free: a robot must not plan through it.
     occupied = np.flipud(~free).copy()
-    return OccupancyMap(occupied, resolution, origin, path, file_sha256(path, image_path))
+    known = np.flipud(free | (occupancy > occupied_thresh)).copy()
+    return OccupancyMap(occupied, resolution, origin, path, file_sha256(path, image_path), known)
 
 
 def coarsen(occupied: np.ndarray, factor: int) -> np.ndarray:

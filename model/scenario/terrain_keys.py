@@ -3,10 +3,11 @@
 Checked here, before any process starts; every problem raises :class:`model.scenario.terrain.TerrainError`
 naming the key or the file (the scenario loader reports it as a scenario error).
 
-- ``map = "office.yaml"``: a ROS map, relative to the scenario file. The domain is the map's extent
-  (``domain``, if given, must agree), and the coverage cell is the map's resolution unless ``cell``
-  says otherwise (a whole number of pixels). World coordinates are the map's, less its origin: the
-  model's domain always starts at (0, 0).
+- ``map = "office.yaml"``: a ROS map, relative to the scenario file. The domain is the map's known extent
+  (:mod:`model.scenario.map_fit`: the unknown border cropped, padded to whole cells; ``domain``, if given,
+  must agree), and the coverage cell is the map's resolution unless ``cell`` says otherwise (a whole number
+  of pixels). The model's domain starts at (0, 0) at the fitted map's lower-left corner; what a user reads
+  (trajectory.csv, a ROS 2 base's frames) is in the map's own frame.
 - ``obstacles = [[[x, y], ...], ...]``: polygons, with or without a map.
 - ``robot_radius`` (≥ 0) and ``occlusion`` (true or false).
 - ``lambda_star = "priority.png"`` with ``lambda_star_min`` and ``lambda_star_max``: a priority map,
@@ -19,6 +20,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from model.scenario.map_fit import fit_to_cells
 from model.scenario.terrain import TerrainError, check_polygon, load_occupancy_map
 
 
@@ -36,7 +38,14 @@ def _resolve_map(values: dict[str, Any], base: Path) -> None:
     if not path.is_file():
         raise TerrainError(f"scenario key 'map': the map file {path} does not exist")
     occupancy_map = load_occupancy_map(path)
-    extent = occupancy_map.extent
+    values.setdefault("cell", occupancy_map.resolution)
+    cell = values["cell"]
+    if isinstance(cell, bool) or not isinstance(cell, int | float) or not math.isfinite(cell) or cell <= 0:
+        raise TerrainError(
+            f"scenario key 'cell': expected a whole multiple of the map's resolution {occupancy_map.resolution}, "
+            f"got {cell!r}"
+        )
+    extent = fit_to_cells(occupancy_map, float(cell)).extent  # the unknown border cropped, whole cells
     if "domain" in values:
         given = values["domain"]
         if (
@@ -49,13 +58,6 @@ def _resolve_map(values: dict[str, Any], base: Path) -> None:
                 f"got {given!r}"
             )
     values["domain"] = list(extent)
-    values.setdefault("cell", occupancy_map.resolution)
-    factor = float(values["cell"]) / occupancy_map.resolution if isinstance(values["cell"], int | float) else 0.0
-    if round(factor) < 1 or abs(round(factor) - factor) > 1e-9 * factor:
-        raise TerrainError(
-            f"scenario key 'cell': expected a whole multiple of the map's resolution {occupancy_map.resolution}, "
-            f"got {values['cell']!r}"
-        )
     values["map"] = str(path)
 
 

@@ -1,6 +1,6 @@
 """The world a team covers, built once per scenario: walls, where a robot can go, what it can see.
 
-- ``occupied``: the map on the coverage grid (:func:`model.scenario.terrain.map_on_grid`) or'd with the
+- ``occupied``: the map fitted to the coverage grid (:mod:`model.scenario.map_fit`: its unknown border cropped, padded to whole cells) or'd with the
   polygons (:func:`model.scenario.terrain.polygons_on_grid`).
 - ``passable``: centres that hold the robot's disk with PLANNING_MARGIN to spare (:func:`model.world.geodesic.passable_cells`).
 - ``reachable``: the team's space, the largest 8-connected component of passable cells (lowest
@@ -29,7 +29,15 @@ from scipy.sparse.csgraph import connected_components
 
 from model.paper.fixed_point import COVERAGE_SCALE
 from model.scenario import Scenario
-from model.scenario.terrain import TerrainError, file_sha256, load_occupancy_map, map_on_grid, polygons_on_grid
+from model.scenario.map_fit import FittedMap, fit_to_cells
+from model.scenario.terrain import (
+    OccupancyMap,
+    TerrainError,
+    coarsen,
+    file_sha256,
+    load_occupancy_map,
+    polygons_on_grid,
+)
 from model.world.geodesic import distance_fields, grid_graph, passable_cells
 from model.world.ground import PLANNING_MARGIN, Ground
 from model.world.reachability import coverable_cells
@@ -113,6 +121,9 @@ class World:
             report["map_sha256"] = self.map_sha256
         if self.priority_sha256:
             report["priority_sha256"] = self.priority_sha256
+        corner = map_corner_of(self.scenario)
+        if corner != (0.0, 0.0):
+            report["map_corner"] = list(corner)  # trajectory.csv is in the map's frame: the model's (0, 0) is here
         return report
 
 
@@ -151,13 +162,33 @@ def _priority_ticks(scenario: Scenario, shape: tuple[int, int]) -> tuple[np.ndar
     return np.rint(low + grey * (high - low)).astype(np.int64), file_sha256(Path(scenario.priority_map))
 
 
+@functools.lru_cache(maxsize=8)
+def fitted_map_of(scenario: Scenario) -> tuple[OccupancyMap, FittedMap]:
+    """The scenario's map as read, and fitted to its cells (:mod:`model.scenario.map_fit`)."""
+    occupancy_map = load_occupancy_map(scenario.map)
+    return occupancy_map, fit_to_cells(occupancy_map, scenario.cell)
+
+
+def map_corner_of(scenario: Scenario) -> tuple[float, float]:
+    """Where the model's (0, 0) lies in the map's own frame (REP 105's ``map``); (0, 0) without a map."""
+    return fitted_map_of(scenario)[1].corner if scenario.map else (0.0, 0.0)
+
+
+def map_note_of(scenario: Scenario) -> str | None:
+    """What fitting the map to the cells changed (cropped, padded), for the console; None if nothing."""
+    if not scenario.map:
+        return None
+    occupancy_map, fitted = fitted_map_of(scenario)
+    return fitted.note(occupancy_map)
+
+
 def _occupied(scenario: Scenario) -> tuple[np.ndarray, str]:
     rows, cols = scenario.grid_shape
     occupied = np.zeros((rows, cols), dtype=bool)
     sha = ""
     if scenario.map:
-        occupancy_map = load_occupancy_map(scenario.map)
-        occupied |= map_on_grid(occupancy_map, scenario.cell)
+        occupancy_map, fitted = fitted_map_of(scenario)
+        occupied |= coarsen(fitted.occupied, fitted.factor)
         sha = occupancy_map.sha256
     if scenario.obstacles:
         polygons = [np.array(polygon, dtype=np.float64) for polygon in scenario.obstacles]

@@ -1,0 +1,137 @@
+"""model.scenario.map_fit: a map as map_saver writes it (any pixel size, a wide unknown border, an origin
+that is not (0, 0)) loads with any cell that is a whole number of its pixels: the border cropped, the rest
+padded with unknown to whole cells, the console told; the run's poses are in the map's own frame."""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+
+import cv2
+import numpy as np
+import pytest
+
+from anicov.engine import run_scenario
+from model.scenario import ScenarioError, load_scenario
+from model.scenario.map_fit import MARGIN_CELLS, fit_to_cells
+from model.scenario.terrain import coarsen, load_occupancy_map, map_on_grid
+from model.world.world import map_corner_of, world_of
+from runtime.rundir import write_run_directory
+from tests.teamrun import ROOT, limit
+
+FREE, WALL, UNKNOWN = 254, 0, 205
+ORIGIN = (-10.0, -12.3)
+RESOLUTION = 0.05
+
+
+def saved_map(folder, rows=423, cols=286):
+    """A map_saver-like map: 0.05 m pixels, unknown everywhere but a 6.05 × 4.05 m room (121 × 81 pixels, an
+    odd number of each: no cell of 0.1 m fits it whole), its walls one pixel thick with a one-pixel gap, an
+    unknown island and a round pillar inside."""
+    image = np.full((rows, cols), UNKNOWN, dtype=np.uint8)
+    top, left, height, width = 150, 70, 81, 121  # image rows count from the top
+    image[top : top + height, left : left + width] = WALL
+    image[top + 1 : top + height - 1, left + 1 : left + width - 1] = FREE
+    image[top + 40, left] = FREE  # a one-pixel gap in the west wall: the map's truth
+    image[top + 20 : top + 24, left + 30 : left + 34] = UNKNOWN  # an unscanned island
+    cv2.circle(image, (left + 80, top + 50), 5, WALL, -1)  # a pillar
+    cv2.imwrite(str(folder / "saved.pgm"), image)
+    (folder / "saved.yaml").write_text(
+        "image: saved.pgm\nmode: trinary\nresolution: 0.05\n"
+        f"origin: [{ORIGIN[0]}, {ORIGIN[1]}, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    room_bottom_row = rows - (top + height)  # the room's lowest pixel row, counted from the bottom
+    return folder / "saved.yaml", (left, room_bottom_row, width, height)
+
+
+def test_the_unknown_border_is_cropped_in_whole_cells_and_the_rest_padded(tmp_path):
+    path, (left, bottom, _, _) = saved_map(tmp_path)
+    source = load_occupancy_map(path)
+    fitted = fit_to_cells(source, 0.1)
+    assert fitted.factor == 2 and fitted.occupied.shape[0] % 2 == 0 and fitted.occupied.shape[1] % 2 == 0
+    cut_left, cut_right, cut_bottom, cut_top = fitted.cropped
+    assert cut_left % 2 == 0 and cut_bottom % 2 == 0  # whole cells from the image's corner
+    assert left - 2 * MARGIN_CELLS - 1 <= cut_left <= left - 2 * MARGIN_CELLS  # a cell of margin, no more
+    assert bottom - 2 * MARGIN_CELLS - 1 <= cut_bottom <= bottom - 2 * MARGIN_CELLS
+    assert fitted.padded != (0, 0)
+    # Every pixel the fit kept is the map's, every pixel it added is unknown (not free).
+    rows, cols = source.occupied.shape
+    kept = source.occupied[cut_bottom : rows - cut_top, cut_left : cols - cut_right]
+    assert np.array_equal(fitted.occupied[: kept.shape[0], : kept.shape[1]], kept)
+    assert fitted.occupied[kept.shape[0] :, :].all() and fitted.occupied[:, kept.shape[1] :].all()
+    # The domain is the building, not the void: about the room plus a cell each side.
+    assert fitted.extent[0] < 6.6 and fitted.extent[1] < 4.6
+    assert fitted.corner == pytest.approx((ORIGIN[0] + cut_left * RESOLUTION, ORIGIN[1] + cut_bottom * RESOLUTION))
+    note = fitted.note(source)
+    assert "286 × 423 pixels" in note and "padded with unknown to whole cells of 0.1" in note
+
+
+def test_cells_are_the_whole_images_cells(tmp_path):
+    """Cropping in whole cells from the corner leaves every kept cell what it is on the whole image."""
+    path, _ = saved_map(tmp_path, rows=424, cols=286)  # even sizes: the whole image splits into cells
+    source = load_occupancy_map(path)
+    fitted = fit_to_cells(source, 0.1)
+    whole = map_on_grid(source, 0.1)
+    left, bottom = fitted.cropped[0] // 2, fitted.cropped[2] // 2
+    cells = coarsen(fitted.occupied, 2)
+    kept = whole[bottom : bottom + cells.shape[0], left : left + cells.shape[1]]
+    assert np.array_equal(cells[: kept.shape[0], : kept.shape[1]], kept)
+
+
+def test_a_map_known_everywhere_in_whole_cells_is_not_changed():
+    source = load_occupancy_map(ROOT / "scenarios" / "maps" / "office.yaml")
+    fitted = fit_to_cells(source, 1.0)
+    assert fitted.cropped == (0, 0, 0, 0) and fitted.padded == (0, 0) and fitted.corner == (0.0, 0.0)
+    assert np.array_equal(fitted.occupied, source.occupied) and fitted.note(source) is None
+
+
+def test_a_cell_that_is_not_whole_pixels_is_refused_by_key(tmp_path):
+    path, _ = saved_map(tmp_path)
+    (tmp_path / "s.toml").write_text(f'map = "{path.name}"\ncell = 0.075\n')
+    with pytest.raises(ScenarioError, match=r"'cell': expected a whole multiple of the map's resolution 0\.05"):
+        load_scenario(tmp_path / "s.toml")
+
+
+def scenario_on_saved_map(tmp_path):
+    path, _ = saved_map(tmp_path)
+    (tmp_path / "s.toml").write_text(
+        f'map = "{path.name}"\ncell = 0.1\nagents = 1\nseed = 3\nrange = 1.2\nhalf_angle_deg = 30.0\n'
+        "robot_radius = 0.105\nk_v = 0.22\nk_omega = 0.9\nmax_time = 6000.0\n"
+    )
+    return load_scenario(tmp_path / "s.toml")
+
+
+def test_a_run_on_a_saved_map_completes_with_its_poses_in_the_maps_frame(tmp_path):
+    scenario = scenario_on_saved_map(tmp_path)
+    corner = map_corner_of(scenario)
+    assert scenario.domain[0] < 6.6 and corner != (0.0, 0.0)
+    world = world_of(scenario)
+    # The one-pixel gap and the island: no coverable cell outside the room's walls is reached through it.
+    assert world.coverable.sum() > 0 and world.unreachable_cells >= 0
+    result = run_scenario(scenario)
+    assert result.completed, result.errors[-1]
+    summary = write_run_directory(result, tmp_path / "out")
+    assert summary["terrain"]["map_corner"] == pytest.approx(list(corner))
+    with open(tmp_path / "out" / "trajectory.csv") as source:
+        rows = list(csv.DictReader(source))
+    xs, ys = np.array([float(r["x"]) for r in rows]), np.array([float(r["y"]) for r in rows])
+    model_x, model_y = result.trace[:, 0, 0], result.trace[:, 0, 1]
+    assert np.allclose(xs, model_x + corner[0]) and np.allclose(ys, model_y + corner[1])
+    # In the map's frame the robot stays inside the room the image draws (origin + pixels × resolution).
+    room_x = ORIGIN[0] + 70 * RESOLUTION, ORIGIN[0] + (70 + 121) * RESOLUTION
+    assert room_x[0] < xs.min() and xs.max() < room_x[1]
+
+
+def test_anicov_run_says_on_the_console_what_the_fit_changed(tmp_path):
+    scenario_on_saved_map(tmp_path)
+    done = subprocess.run(
+        [sys.executable, "-m", "anicov.cli", "run", "--config", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
+         "--quiet", "--no-record"],
+        cwd=ROOT, capture_output=True, text=True, timeout=limit(300),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "note: map saved.yaml: 286 × 423 pixels of 0.05; unknown border cropped" in done.stderr
+    assert "padded with unknown to whole cells of 0.1" in done.stderr
+    assert json.loads((tmp_path / "o" / "summary.json").read_text())["completed"]
