@@ -268,7 +268,7 @@ def main(argv: list[str] | None = None) -> int:
                 # After the end of the run every child leaves by itself (the logger flushes first).
                 wait_for_exit(children, GRACE_SECONDS)
                 if not args.no_coordinator:
-                    note_failed_agents(children, seen)
+                    note_failed_agents(children, seen, watch)
             stop_children(children)
             stop_children(bases)
     if stop.stopped:
@@ -380,9 +380,13 @@ def supervise(
     return seen
 
 
-def note_failed_agents(children: list[Child], seen: Supervision) -> None:
+def note_failed_agents(children: list[Child], seen: Supervision, watch: ControlWatch) -> None:
     """Agents that left the run failing and were not seen go (one that failed as the run ended, after the
-    last look of :func:`supervise`): reported as lost, never silently."""
+    last look of :func:`supervise`): reported as lost, never silently. An aborted run's agents all exit
+    failing: that is the abort, reported as such."""
+    ending = watch.latest.get("done")
+    if ending is not None and ending.kind == "abort":
+        return
     for child in children:
         code = child.process.poll()
         if child.role.startswith("agent-") and code not in (None, 0) and child.role not in seen.lost:

@@ -81,7 +81,7 @@ def _engine_rate_once(agents: int, steps: int, scenario_path: Path, **overrides:
 
     def advance(coverage: np.ndarray, at: np.ndarray, count: int) -> int:
         done, _, _ = advance_team(
-            coverage, at, objectives, law, world.ground, fields, safety, memory, looks, count,
+            coverage, at, objectives, law, world.ground, fields, safety, memory, looks, 0, count,
             coverage_map.uncovered_cells, coverage_map.deficit_ticks, total, trace, errors, flags,
         )  # fmt: skip
         return done

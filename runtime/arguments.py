@@ -82,7 +82,8 @@ def scenario_from_arguments(args: argparse.Namespace) -> Scenario:
             f"scenario key 'comm_range' ({scenario.comm_range}): a limited radio needs --clock realtime on the bus "
             "(lockstep steps travel in the coordinator's go); leave comm_range out, or run it with anicov run"
         )
-    if getattr(args, "clock", None) is not None and not controller_of(scenario).supports.team:
+    controller = controller_of(scenario)
+    if getattr(args, "clock", None) is not None and (not controller.supports.team or controller.flies_pilots):
         # A team command (it has a clock): every robot must decide step by step on its own.
         raise ScenarioError(
             f"scenario key 'controller': '{scenario.controller}' flies paths planned once for the team and runs "

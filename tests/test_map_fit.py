@@ -135,3 +135,16 @@ def test_anicov_run_says_on_the_console_what_the_fit_changed(tmp_path):
     assert "note: map saved.yaml: 286 × 423 pixels of 0.05; unknown border cropped" in done.stderr
     assert "padded with unknown to whole cells of 0.1" in done.stderr
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["completed"]
+
+
+def test_another_cell_refits_the_map_with_its_own_domain_and_corner(tmp_path):
+    """The fitted extent and corner depend on the cell (the crop is in whole cells): a scenario on a saved
+    map takes another cell (a sweep's grid.cell) and gets that cell's fit, not the old domain refused."""
+    scenario = scenario_on_saved_map(tmp_path)
+    coarser = scenario.with_overrides(cell=0.2)
+    path, _ = saved_map(tmp_path)
+    fitted = fit_to_cells(load_occupancy_map(path), 0.2)
+    assert coarser.domain == pytest.approx(fitted.extent) and map_corner_of(coarser) == pytest.approx(fitted.corner)
+    assert coarser.grid_shape == (fitted.occupied.shape[0] // 4, fitted.occupied.shape[1] // 4)
+    with pytest.raises(ScenarioError, match="'domain': the map .* spans"):
+        scenario.with_overrides(cell=0.2, domain=list(scenario.domain))

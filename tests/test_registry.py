@@ -24,6 +24,15 @@ class Still(Controller):
 
 NOT_A_CONTROLLER = 42
 
+class NeverPlans(Controller):
+    name = "never-plans"
+
+    def command(self, view):
+        return 0.0, 0.0
+
+    def plan_steps(self, scenario):
+        return 0
+
 class Grumpy(Controller):
     name = "grumpy"
 
@@ -100,6 +109,10 @@ def test_a_constructor_that_raises_is_named_when_the_scenario_is_read(plugin_dir
         ({"controller": "anicov", "planning": "local"}, "'anicov' plans for the whole team at once"),
         ({"controller": "{module}:Still", "robot_radius": 0.3}, "knows no walls or robot bodies"),
         ({"controller": "{module}:Still", "comm_range": 30.0}, "run the compiled controllers only"),
+        (
+            {"controller": "{module}:NeverPlans"},
+            r"plans every 0 steps \(plan_steps\); expected a whole number of at least 1",
+        ),
     ],
 )
 def test_the_scenario_check_asks_the_controller_what_it_supports(plugin_dir, values, message):

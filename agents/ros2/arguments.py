@@ -53,7 +53,7 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
         type=float,
         nargs=2,
         metavar=("X", "Y"),
-        help="map-frame point (metres) of the scenario's (0, 0) (default: the scenario map's origin, or 0 0)",
+        help="map-frame point (metres) of the scenario's (0, 0) (default: where the scenario's map puts it, its origin plus any unknown border cropped; or 0 0)",
     )
     ros.add_argument(
         "--ros-pose-timeout",

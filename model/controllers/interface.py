@@ -109,6 +109,11 @@ class Controller:
         return None
 
     @property
+    def flies_pilots(self) -> bool:
+        """Whether its robots fly paths planned once (:meth:`pilots`): the engine runs them, a team cannot."""
+        return type(self).pilots is not Controller.pilots
+
+    @property
     def compiled(self) -> bool:
         """Whether the step is the compiled kernel's (:meth:`law`) rather than :meth:`command`."""
         return type(self).command is Controller.command

@@ -98,6 +98,12 @@ def check_supports(scenario: Scenario) -> str | None:
             f"scenario key 'planning': 'local' runs the planner on each robot; controller '{scenario.controller}' "
             f'plans for the whole team at once: use planning = "central"'
         )
+    steps = controller.plan_steps(scenario)
+    if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
+        return (
+            f"scenario key 'controller': '{scenario.controller}' plans every {steps!r} steps (plan_steps); "
+            "expected a whole number of at least 1"
+        )
     if (math.isfinite(scenario.comm_range) or scenario.planning == "local") and not controller.compiled:
         return (
             f"scenario key 'controller': a limited radio and local planning run the compiled controllers only; "

@@ -10,7 +10,7 @@ border of unknown).
 - **Frame**: the model's domain starts at (0, 0) at the fitted image's lower-left corner; in the map's own
   frame (REP 105's ``map``, what RViz shows) that corner lies at :attr:`FittedMap.corner`, the map's
   ``origin`` plus the pixels cropped at the left and bottom. Poses written for a user (trajectory.csv, the
-  ROS 2 bases' odometry and commands) are in the map's frame: :func:`to_map_frame`.
+  ROS 2 bases' odometry and commands) are in the map's frame: the model's plus that corner.
 
 Unknown pixels inside the free space (a SLAM map's unscanned islands) stay not free: no robot plans through
 them and no camera sees through them. A map whose known pixels span the whole image and split into whole
@@ -112,8 +112,3 @@ def fit_to_cells(occupancy_map: OccupancyMap, cell: float) -> FittedMap:
         (int(left), int(cols - right), int(bottom), int(rows - top)),
         (int(pad_cols), int(pad_rows)),
     )
-
-
-def to_map_frame(xy: np.ndarray, corner: tuple[float, float]) -> np.ndarray:
-    """Model-frame positions (…, 2) in the map's frame: the fitted image's corner added."""
-    return xy + np.asarray(corner, dtype=np.float64)

@@ -132,7 +132,10 @@ class Scenario:
     def with_overrides(self, **overrides: Any) -> Scenario:
         """A validated copy with some keys replaced (``None`` values are ignored)."""
         given = {key: value for key, value in overrides.items() if value is not None}
-        return validate(self.to_dict() | given)
+        values = self.to_dict() | given
+        if self.map and "domain" not in given:
+            del values["domain"]  # the map's fitted extent depends on the cell (model.scenario.map_fit)
+        return validate(values)
 
 
 UNIT_KEYS = ("metres_per_unit", "seconds_per_unit")
