@@ -80,6 +80,7 @@ def simulate_routes(
     ground, nobody = open_ground(), np.zeros((0, 2))
     ticks = coverage_map_of(scenario).coverage if coverage is None else coverage
     times = np.zeros(len(routes))
+    plan_steps = scenario.plan_steps  # read once: it asks the scenario's controller
     for index, points in enumerate(routes):
         route = Route.of(points, stops=None if stops is None else stops[index])
         x, y = float(positions[index][0]), float(positions[index][1])
@@ -87,7 +88,7 @@ def simulate_routes(
         theta = math.atan2(carrot[1] - y, carrot[0] - x)
         step = 0
         while step < MAX_SIMULATED_STEPS:
-            if step % scenario.plan_steps == 0:
+            if step % plan_steps == 0:
                 route.advance(np.array([x, y]), lookahead)
                 if route.done():
                     break
