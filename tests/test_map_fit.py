@@ -146,5 +146,5 @@ def test_another_cell_refits_the_map_with_its_own_domain_and_corner(tmp_path):
     fitted = fit_to_cells(load_occupancy_map(path), 0.2)
     assert coarser.domain == pytest.approx(fitted.extent) and map_corner_of(coarser) == pytest.approx(fitted.corner)
     assert coarser.grid_shape == (fitted.occupied.shape[0] // 4, fitted.occupied.shape[1] // 4)
-    with pytest.raises(ScenarioError, match="'domain': the map .* spans"):
+    with pytest.raises(ScenarioError, match=r"'domain': the map .* spans"):
         scenario.with_overrides(cell=0.2, domain=list(scenario.domain))
