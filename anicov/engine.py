@@ -111,7 +111,7 @@ def run_scenario(
         return _run_pilots(scenario, coverage_map, poses, pilots, record_trace, progress)
     if math.isfinite(scenario.comm_range) or scenario.planning == "local":
         return run_ranged(scenario, coverage_map, poses, record_trace, progress)
-    law, world = law_parameters(scenario, coverage_map), world_of(scenario)
+    law, world = controller.law(scenario, coverage_map.target_ticks), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     looks = np.full((scenario.agents, 2), np.nan)  # nothing looked at yet (model.step.no_look)
     planner, block = controller.planner(scenario), controller.plan_steps(scenario)

@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from model.controllers.registry import is_file_path
 from model.scenario import PAPER_SCENARIO, Scenario, ScenarioError, load_scenario
 
 FIGURES = (
@@ -109,7 +110,7 @@ def load_sweep(path: Path) -> Sweep:
         raise ScenarioError(f"{path}: grid: 'seed' is given by the top-level key seeds")
     for name, values in grid.items():
         for index, value in enumerate(values):
-            if name == "controller" and isinstance(value, str) and ".py:" in value:
+            if name == "controller" and isinstance(value, str) and is_file_path(value):
                 value = str(path.parent / value)  # a controller's file, relative to this file as the scenario is
             try:
                 # As the scenario holds it (20 and 20.0 are one range), so a resumed sweep finds its rows.

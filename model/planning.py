@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from model.paper.objectives import BlobObjectives
 from model.world.geodesic import path_length
 from model.world.world import World
 
@@ -20,6 +21,9 @@ class TeamPlanner:
     """The team's planning: ``plan`` gives every member (by id; default all, in id order) its objective
     (x, y), shape (N, 2); ``labels`` and ``record`` are what the recording keeps of the last plan."""
 
+    blobs: BlobObjectives | None = None
+    """Algorithm 1's blobs of the last plan, when the planner runs it: what the recording keeps of a plan."""
+
     cut_at_start = False
     """True when the first plan fixes each robot's whole route from the starting poses: a coordinator
     rebuilt in realtime plans step 0 again from those poses, then :meth:`resume`s."""
@@ -29,11 +33,14 @@ class TeamPlanner:
 
     def labels(self) -> np.ndarray | None:
         """The blob labels of the last plan, as the recording keeps them (uint16), or None."""
-        return None
+        if self.blobs is None or self.blobs.labels is None:
+            return None
+        return self.blobs.labels.astype(np.uint16)
 
     def record(self, step: int, targets: np.ndarray) -> Plan:
         """This plan as kept for the recording: members are all agents, in id order."""
-        return (step, tuple(range(len(targets))), targets.copy(), np.zeros((0, 2)), self.labels())
+        centres = np.zeros((0, 2)) if self.blobs is None else self.blobs.positions.copy()
+        return (step, tuple(range(len(targets))), targets.copy(), centres, self.labels())
 
     def resume(self, lack: np.ndarray, positions: list[tuple[float, float]], members: list[int]) -> str | None:
         """Put each member back on its plan after a restart (realtime); what was done, for the run log."""

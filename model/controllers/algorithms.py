@@ -13,7 +13,7 @@ import numpy as np
 
 from model.paper.assignment import assign_objectives
 from model.paper.objectives import BlobObjectives, fallback_objective, select_objectives
-from model.planning import Plan, TeamPlanner, path_lengths
+from model.planning import TeamPlanner, path_lengths
 from model.scenario import Scenario
 from model.world.reachability import nearest_reachable
 from model.world.world import world_of
@@ -50,11 +50,3 @@ class Planner(TeamPlanner):
             return objectives[assign_objectives(positions, objectives)]
         objectives = nearest_reachable(world.reachable, objectives, self.scenario.cell)
         return objectives[assign_objectives(positions, objectives, path_lengths(world, positions, objectives))]
-
-    def labels(self) -> np.ndarray | None:
-        """The blob labels of the last plan, as the recording keeps them (uint16), or None."""
-        return None if self.blobs.labels is None else self.blobs.labels.astype(np.uint16)
-
-    def record(self, step: int, targets: np.ndarray) -> Plan:
-        """This plan as kept for the recording: members are all agents, in id order."""
-        return (step, tuple(range(len(targets))), targets.copy(), self.blobs.positions.copy(), self.labels())

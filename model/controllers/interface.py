@@ -66,7 +66,7 @@ class RobotView:
     x: float
     y: float
     theta: float
-    objective_x: float  # what the planner gave this robot (NaN before the first plan)
+    objective_x: float  # what the planner gave this robot at its last plan (every step has one)
     objective_y: float
     e_omega: float  # eq. 6: the mean lack of coverage over the wedge this step
     w_left: float  # eq. 9 split by side: the uncovered weight left and right of the heading

@@ -60,7 +60,7 @@ def canonical_name(name: str, base: Path | None = None) -> str:
     raises ControllerError when it loads no controller."""
     if name == "best":
         name = BEST
-    if _is_file_path(name):
+    if is_file_path(name):
         path, _, attribute = name.rpartition(":")
         name = f"{((base or Path.cwd()) / path).resolve()}:{attribute}"
     _new(name)  # loads it, and makes one: a constructor that raises is found here too
@@ -155,7 +155,8 @@ def _load(name: str, load: object) -> object:
         raise ControllerError(f"controller {name!r} cannot be loaded: {type(error).__name__}: {error}") from error
 
 
-def _is_file_path(name: str) -> bool:
+def is_file_path(name: str) -> bool:
+    """Whether a controller's name is ``path/to/file.py:ClassName`` (rather than a module path or a name)."""
     path = name.rpartition(":")[0]
     return path.endswith(".py")
 
@@ -164,7 +165,7 @@ def _import_attribute(name: str) -> object:
     module_name, _, attribute = name.rpartition(":")
     if not module_name or not attribute:
         raise ControllerError(f"controller {name!r}: expected module.path:ClassName or path/to/file.py:ClassName")
-    if _is_file_path(name):
+    if is_file_path(name):
         module = _module_from_file(Path(module_name))
     else:
         module = importlib.import_module(module_name)

@@ -58,7 +58,7 @@ from model.controllers.anicov.stations import station_routes, with_patched_stops
 from model.controllers.anicov.touch_ups import TouchUp, blob_labels, with_touch_ups
 from model.controllers.anicov.weave import sweep_of
 from model.paper.objectives import BlobObjectives
-from model.planning import Plan, TeamPlanner
+from model.planning import TeamPlanner
 from model.scenario import Scenario
 
 LOOKAHEAD = 2.0
@@ -270,9 +270,3 @@ class LanePlanner(TeamPlanner):
                 continue
             route.draw_ahead(claimed, cell, width)
         return np.where(claimed.astype(bool), 0.0, lack)
-
-    def labels(self) -> np.ndarray | None:
-        return None if self.blobs.labels is None else self.blobs.labels.astype(np.uint16)
-
-    def record(self, step: int, targets: np.ndarray) -> Plan:
-        return (step, tuple(range(len(targets))), targets.copy(), self.blobs.positions.copy(), self.labels())
