@@ -27,6 +27,7 @@ from model.controllers import controller_of, law_parameters
 from model.controllers.interface import Pilot
 from model.paper.coverage_map import CoverageMap, add_window
 from model.parameters import coverage_map_of, safety_parameters, starting_poses
+from model.planning import watched_planner
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack, snapshot_steps
 from model.safety.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
@@ -114,7 +115,7 @@ def run_scenario(
     law, world = controller.law(scenario, coverage_map.target_ticks), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     looks = np.full((scenario.agents, 2), np.nan)  # nothing looked at yet (model.step.no_look)
-    planner, block = controller.planner(scenario), controller.plan_steps(scenario)
+    planner, block = watched_planner(scenario, controller.planner(scenario)), controller.plan_steps(scenario)
     advance = advance_team if controller.compiled else functools.partial(advance_plugin_team, controller, scenario)
     agents = scenario.agents
     traces: list[np.ndarray] = []
@@ -127,9 +128,11 @@ def run_scenario(
     next_snapshot = SNAPSHOT_PERIOD
     while steps_done < scenario.max_steps and not coverage_map.complete:
         lack = coverage_map.lack_of_coverage()
-        objectives = planner.plan(lack, poses[:, :2])
+        if planner.only_given_up_left(lack):
+            break  # the watchdog gave up every cell left (model.watchdog); the coordinator stops here too
+        objectives = planner.plan(steps_done * scenario.dt, lack, poses[:, :2])
         if record_trace:
-            plans.append(planner.record(steps_done, objectives))
+            plans.append(planner.planner.record(steps_done, objectives))
         steps = min(block, scenario.max_steps - steps_done)
         done, coverage_map.uncovered_cells, coverage_map.deficit_ticks = advance(
             coverage_map.coverage, poses, objectives, law, world.ground, objective_fields(world, objectives),
@@ -154,6 +157,7 @@ def run_scenario(
         scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace
     )
     result.plans = plans
+    result.stalls, result.given_up = list(planner.stalls), planner.given_up()
     result.safety_flags = np.concatenate(flags) if flags else np.zeros((0, agents), dtype=np.uint8)
     return result
 

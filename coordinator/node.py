@@ -17,6 +17,7 @@ import numpy as np
 
 from coordinator.run_log import RunLog
 from model.controllers import controller_of
+from model.planning import watched_planner
 from model.run import RunResult, snapshot_steps
 from model.scenario import Scenario
 from protocol.inbox import Inbox, Membership, Received
@@ -46,6 +47,7 @@ class Coordinator:
         self.limits = Limits.of(scenario)
         self.replica = MapReplica.of(scenario)
         self.planner = controller_of(scenario).planner(scenario)
+        self.watched = watched_planner(scenario, self.planner)  # the progress watchdog around it (model.watchdog)
         self.inbox = Inbox(self.limits, options.drop_rate, seed=999)
         self.alive: set[int] = set()
         self.members: set[int] = set()
@@ -187,7 +189,8 @@ class Coordinator:
         if members and (
             step % self.scenario.plan_steps == 0 or self.membership_changed or len(self.targets) != len(members)
         ):
-            self.targets = self.planner.plan(self.replica.map.lack_of_coverage(), positions, members)
+            lack = self.replica.map.lack_of_coverage()
+            self.targets = self.watched.plan(step * self.scenario.dt, lack, positions, members)
             self.membership_changed = False
             return Objectives(step, tuple(members), self.targets, self.planner.blobs.positions, self.planner.labels())
         return Objectives(step, tuple(members), self.targets, self.planner.blobs.positions)
@@ -213,8 +216,17 @@ class Coordinator:
             self.take_snapshot(step * self.scenario.dt)
 
     def run_is_over(self, step: int) -> bool:
-        """The end of a run at ``step``: the map is complete, max_time is reached, or no member is left."""
-        return self.replica.map.complete or step >= self.scenario.max_steps or not self.members
+        """The end of a run at ``step``: the map is complete, max_time is reached, no member is left, or on a
+        replanning step (where the engine looks too) the watchdog has given up every cell left."""
+        return (
+            self.replica.map.complete
+            or step >= self.scenario.max_steps
+            or not self.members
+            or (
+                step % self.scenario.plan_steps == 0
+                and self.watched.only_given_up_left(self.replica.map.lack_of_coverage())
+            )
+        )
 
     def take_snapshot(self, time_now: float) -> None:
         """Keep Υ at ``time_now`` (Fig. 6 and the recording)."""
@@ -222,4 +234,6 @@ class Coordinator:
 
     def result(self, steps: int, completed: bool, completion_step: int) -> RunResult:
         """The run as the engine would return it, from what this coordinator saw."""
-        return self.log.result(self.scenario, steps, completed, completion_step, self.replica.map.lack_of_coverage())
+        result = self.log.result(self.scenario, steps, completed, completion_step, self.replica.map.lack_of_coverage())
+        result.stalls, result.given_up = list(self.watched.stalls), self.watched.given_up()
+        return result

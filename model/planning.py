@@ -7,11 +7,17 @@ coordinator process call the same one, so the objectives of a run do not depend 
 
 from __future__ import annotations
 
+import functools
+from dataclasses import dataclass
+
 import numpy as np
 
 from model.paper.objectives import BlobObjectives
+from model.scenario import Scenario
+from model.watchdog import ProgressWatchdog, Stall
 from model.world.geodesic import path_length
-from model.world.world import World
+from model.world.visibility import segment_crosses_occupied
+from model.world.world import World, world_of
 
 Plan = tuple[int, tuple[int, ...], np.ndarray, np.ndarray, np.ndarray | None]
 """(step, members, targets (N, 2), blob objectives Ψ (M, 2), blob labels of the grid or None)."""
@@ -60,3 +66,104 @@ def path_lengths(world: World, positions: np.ndarray, objectives: np.ndarray) ->
                 field, ground.occupied, x, y, goal_x, goal_y, cell, ground.plan_radius, ground.bounded, lengths[i, j]
             )
     return lengths
+
+
+def stall_reason(
+    world: World,
+    lack: np.ndarray,
+    agent: int,
+    position: tuple[float, float],
+    objective: tuple[float, float],
+    moved: float,
+) -> str:
+    """Why a robot made no progress, in words (model.watchdog): did it move, is it at its objective, can it
+    get there, and what uncovered cells it sees from where it stands (within R, no wall across)."""
+    cell = world.scenario.cell
+    x, y = position
+    gap = float(np.hypot(objective[0] - x, objective[1] - y))
+    parts = ["stood still" if moved < cell else f"drove {moved:.1f} and covered nothing"]
+    rows, cols = lack.shape
+    goal = min(max(int(objective[1] // cell), 0), rows - 1), min(max(int(objective[0] // cell), 0), cols - 1)
+    if gap <= cell:
+        parts.append("at its objective")
+    elif not world.reachable[goal]:
+        parts.append(
+            f"its objective, {gap:.2f} away, is not where a robot of radius {world.scenario.robot_radius} can go"
+        )
+    else:
+        parts.append(f"{gap:.2f} from its objective")
+    seen = _uncovered_in_sight(world, lack, x, y)
+    parts.append(f"sees {seen} uncovered cells within R" if seen else "sees no uncovered cell within R")
+    return ", ".join(parts)
+
+
+def _uncovered_in_sight(world: World, lack: np.ndarray, x: float, y: float) -> int:
+    cell, reach = world.scenario.cell, world.scenario.range
+    rows, cols = lack.shape
+    span = int(np.ceil(reach / cell))
+    row, col = int(y // cell), int(x // cell)
+    count = 0
+    for r in range(max(row - span, 0), min(row + span + 1, rows)):
+        for c in range(max(col - span, 0), min(col + span + 1, cols)):
+            if lack[r, c] <= 0.0:
+                continue
+            cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
+            if np.hypot(cx - x, cy - y) < reach and not segment_crosses_occupied(world.occupied, x, y, cx, cy, cell):
+                count += 1
+    return count
+
+
+def default_patience(world: World) -> float:
+    """model.watchdog's default: twice the time to drive across the reachable space at k_v (its geodesic
+    diameter, by a double sweep), and at least 20 replanning periods."""
+    scenario = world.scenario
+    if world.open:
+        across = float(np.hypot(*scenario.domain))
+    else:
+        start = np.argwhere(world.reachable)[0]
+        first = world._field(int(start[0]), int(start[1]))
+        far = np.unravel_index(int(np.argmax(np.where(np.isfinite(first) & world.reachable, first, -1.0))), first.shape)
+        second = world._field(int(far[0]), int(far[1]))
+        across = float(np.max(np.where(np.isfinite(second) & world.reachable, second, 0.0)))
+    return max(2.0 * across / scenario.k_v, 20.0 * scenario.replan_period)
+
+
+@dataclass
+class WatchedPlanner:
+    """A team planner with the progress watchdog (model.watchdog) around it: the engine and the coordinator
+    call :meth:`plan` with the time, so both see the same stalls and plan the same."""
+
+    planner: TeamPlanner
+    world: World
+    watchdog: ProgressWatchdog | None
+
+    def plan(
+        self, time: float, lack: np.ndarray, positions: np.ndarray, members: list[int] | None = None
+    ) -> np.ndarray:
+        if self.watchdog is None:
+            return self.planner.plan(lack, positions, members)
+        ids = list(range(len(positions))) if members is None else list(members)
+        self.watchdog.observe(time, lack, positions, ids, functools.partial(stall_reason, self.world, lack))
+        targets = self.planner.plan(self.watchdog.masked(lack), positions, members)
+        self.watchdog.remember(targets, ids)
+        return targets
+
+    def only_given_up_left(self, lack: np.ndarray) -> bool:
+        """The run is over: every cell left was given up by the watchdog."""
+        return self.watchdog is not None and self.watchdog.only_given_up_left(lack)
+
+    @property
+    def stalls(self) -> list[Stall]:
+        return [] if self.watchdog is None else self.watchdog.stalls
+
+    def given_up(self) -> np.ndarray | None:
+        return None if self.watchdog is None else self.watchdog.given_up
+
+
+def watched_planner(scenario: Scenario, planner: TeamPlanner) -> WatchedPlanner:
+    """The scenario's planner with its watchdog (none when ``watchdog = false``)."""
+    world = world_of(scenario)
+    if not scenario.watchdog:
+        return WatchedPlanner(planner, world, None)
+    patience = scenario.watchdog_time or default_patience(world)
+    return WatchedPlanner(planner, world, ProgressWatchdog(patience, scenario.range, scenario.cell))

@@ -13,6 +13,7 @@ import numpy as np
 
 from model.planning import Plan
 from model.scenario import Scenario
+from model.watchdog import Stall
 
 TRACE_FIELDS = ("x", "y", "theta", "v", "omega", "e_omega")
 """Columns of the per-step trace: pose at the start of the step, then what was applied during it."""
@@ -51,6 +52,8 @@ class RunResult:
     plans: list[Plan] = field(default_factory=list)  # every replan, for the recording
     safety_flags: np.ndarray | None = None  # (steps, N) uint8: what the safety filter did (model.safety.safety)
     radio: dict[str, float] | None = None  # a team on a limited radio (anicov.radio_engine.RadioTeam.figures)
+    stalls: list[Stall] = field(default_factory=list)  # the progress watchdog's interventions (model.watchdog)
+    given_up: np.ndarray | None = None  # bool (rows, cols): cells the watchdog gave up
     timed_positions: dict[int, np.ndarray] | None = None  # realtime: agent → (M, 3) wall time, x, y after each step
 
     @property

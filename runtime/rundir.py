@@ -11,8 +11,11 @@ import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from model.paper.fixed_point import COVERAGE_SCALE
 from model.paper.metrics import optimum_time, total_sensing_ability
+from model.planning import default_patience
 from model.run import RunResult
 from model.safety.safety_record import safety_figures
 from model.world.world import World, map_corner_of, world_of
@@ -69,11 +72,40 @@ def summary_of(result: RunResult) -> dict[str, Any]:
         summary["terrain"] = world.summary()
     if result.radio is not None:
         summary["radio"] = result.radio
+    if result.stalls or not result.completed:
+        summary["watchdog"] = watchdog_report(result, world)
     if scenario.robot_radius > 0.0 and len(result.trace) == result.steps + 1:  # filter on or off, to compare
         summary |= safety_figures(
             result.trace[:, :, :2], result.safety_flags, world.ground, scenario.cell, result.timed_positions
         )
     return summary
+
+
+def watchdog_report(result: RunResult, world: World) -> dict[str, Any]:
+    """What the progress watchdog (model.watchdog) did, and which cells a run that did not complete left, and
+    why: given up by the watchdog (with the robots' reasons in its interventions), or time ran out. Cell
+    centres in the map's frame."""
+    scenario = result.scenario
+    corner = map_corner_of(scenario)
+    left = (result.final_lack > 0.0) & world.coverable
+    given_up = result.given_up if result.given_up is not None else np.zeros_like(left)
+    centres = [
+        [round((col + 0.5) * scenario.cell + corner[0], 4), round((row + 0.5) * scenario.cell + corner[1], 4)]
+        for row, col in np.argwhere(left)
+    ]
+    why = "completed" if result.completed else (
+        "every cell left was given up by the watchdog" if left.any() and not (left & ~given_up).any()
+        else "max_time reached" if result.steps >= scenario.max_steps else "the run was stopped"
+    )  # fmt: skip
+    return {
+        "enabled": scenario.watchdog,
+        "patience": (scenario.watchdog_time or default_patience(world)) if scenario.watchdog else None,
+        "interventions": [stall.as_dict(scenario.cell, corner) for stall in result.stalls],
+        "cells_left": int(left.sum()),
+        "cells_given_up": int((left & given_up).sum()),
+        "why": why,
+        "cells_left_centres": centres,
+    }
 
 
 def covered_area(world: World) -> float:
@@ -93,7 +125,10 @@ def write_summary(summary: dict[str, Any], path: Path) -> None:
 def format_summary(summary: dict[str, Any], out_dir: Path | None = None) -> str:
     """A one-screen, human summary of a run."""
     scenario = summary["scenario"]
-    status = "complete" if summary["completed"] else "NOT complete (max_time reached)"
+    watchdog = summary.get("watchdog")
+    status = (
+        "complete" if summary["completed"] else f"NOT complete ({watchdog['why'] if watchdog else 'max_time reached'})"
+    )
     completion = summary["completion_time"]
     lines = [
         f"anicov run: {scenario['agents']} agent(s), controller {scenario['controller']}, seed {scenario['seed']}",
@@ -112,6 +147,11 @@ def format_summary(summary: dict[str, Any], out_dir: Path | None = None) -> str:
         lines.append(
             f"  terrain         {terrain['occupied_cells']} occupied cells, {terrain['coverable_cells']} coverable, "
             f"{terrain['unreachable_cells']} free but unreachable (left out of e_D)"
+        )
+    if watchdog is not None and (watchdog["interventions"] or watchdog["cells_left"]):
+        lines.append(
+            f"  watchdog        {len(watchdog['interventions'])} interventions; {watchdog['cells_left']} cells left, "
+            f"{watchdog['cells_given_up']} of them given up (summary.json: watchdog)"
         )
     if "min_separation" in summary:
         lines.append(_safety_line(summary))

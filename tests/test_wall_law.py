@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -158,14 +159,32 @@ def test_a_robot_keeps_looking_at_its_cell_until_it_is_covered_then_looks_at_the
 def test_the_law_remembers_what_it_looked_at_and_forgets_it_once_it_drives():
     ground = ground_of(np.zeros((20, 20), dtype=bool))
     coverage = one_uncovered_cell(10, 14)
-    x, y, objective, look = 10.5, 10.5, (11.5, 10.5), no_look()
+    x, y, objective, look = 11.2, 10.5, (11.5, 10.5), no_look()
     u_glo, _ = global_law_among_walls(
         coverage, TARGET, x, y, *objective, -0.3, 0.0, 20.0, 1.0, False, ground, np.zeros((20, 20)), np.zeros((0, 2)),
         look,
     )  # fmt: skip
-    assert u_glo == 0.0 and tuple(look) == (14.5, 10.5)  # within R/2: stops and looks, and remembers
+    assert u_glo == 0.0 and tuple(look) == (14.5, 10.5)  # at its objective: stops and looks, and remembers
+    uncovered_objective = one_uncovered_cell(10, 17)
     u_glo, _ = global_law_among_walls(
-        coverage, TARGET, x, y, *objective, 0.3, 0.0, 20.0, 1.0, False, ground, np.zeros((20, 20)), np.zeros((0, 2)),
-        look,
+        uncovered_objective, TARGET, x, y, 17.5, 10.5, 0.3, 0.0, 20.0, 1.0, False, ground, np.zeros((20, 20)),
+        np.zeros((0, 2)), look,
     )  # fmt: skip
-    assert u_glo == 0.3 and np.isnan(look).all()  # drives: forgets
+    assert u_glo == 0.3 and np.isnan(look).all()  # drives (eq. 10, beyond R/2 of an uncovered objective): forgets
+
+
+def test_a_robot_goes_all_the_way_to_a_covered_objective_and_looks_from_there():
+    # A viewpoint (model.world.reachability.viewpoints) is a covered cell from which the blob is seen: eq. 10's
+    # stop at R/2 left the robot short of it, with the blob at the edge of its range (issue 34's lab map).
+    ground = ground_of(np.zeros((20, 20), dtype=bool))
+    coverage = one_uncovered_cell(10, 14)
+    objective = (11.5, 10.5)  # covered; the uncovered cell (14.5, 10.5) is 3 from it
+    for x in (5.5, 9.6, 10.9):  # beyond R/2 = 2, within it, a cell away
+        look = no_look()
+        gap = 11.5 - x
+        u_glo, theta = global_law_among_walls(
+            coverage, TARGET, x, 10.5, *objective, -0.3, 0.0, 4.0, 1.0, False, ground, np.zeros((20, 20)),
+            np.zeros((0, 2)), look,
+        )  # fmt: skip
+        assert u_glo == pytest.approx((2.0 / math.pi) * math.atan(gap)) and theta == pytest.approx(0.0)
+        assert np.isnan(look).all()

@@ -15,7 +15,7 @@ from model.paper.assignment import assign_objectives
 from model.paper.objectives import BlobObjectives, fallback_objective, select_objectives
 from model.planning import TeamPlanner, path_lengths
 from model.scenario import Scenario
-from model.world.reachability import nearest_reachable
+from model.world.reachability import viewpoints
 from model.world.world import world_of
 
 
@@ -32,7 +32,7 @@ class Planner(TeamPlanner):
         A scenario with fixed ``objectives`` gives each robot its own, Algorithms 1–2 do not run.
 
         On a terrain Algorithm 1 runs on the same Υ (cells nobody can cover are at Λ* already), each
-        objective is then moved into the team's space (:func:`model.world.reachability.nearest_reachable`)
+        objective is then moved to where a robot can see it from (:func:`model.world.reachability.viewpoints`)
         and Algorithm 2 takes the lengths of the shortest free paths to them (:func:`path_lengths`)."""
         if self.scenario.objectives:
             ids = range(len(positions)) if members is None else members
@@ -48,5 +48,5 @@ class Planner(TeamPlanner):
             objectives = fallback[None, :]
         if not terrain:
             return objectives[assign_objectives(positions, objectives)]
-        objectives = nearest_reachable(world.reachable, objectives, self.scenario.cell)
+        objectives = viewpoints(world.occupied, world.reachable, objectives, self.scenario.range, self.scenario.cell)
         return objectives[assign_objectives(positions, objectives, path_lengths(world, positions, objectives))]

@@ -46,6 +46,8 @@ class Scenario:
     max_time: float = 10000.0
     controller: str = "paper"
     replan_period: float = 5.0
+    watchdog: bool = True  # the progress watchdog (model.watchdog): notices, explains and acts on a stall
+    watchdog_time: float = 0.0  # how long e_D may stay flat before it acts; 0: automatic (model.watchdog)
     weave: bool = True  # anicov: robots weave their heading where that sweeps faster (model.controllers.anicov.weave); false: straight
     stations: bool = True  # anicov: robots stand at stations and turn their camera, hopping between (model.controllers.anicov.stations); false: a spiral
     # Terrain (issue 11); the defaults are the paper's open world and leave every run as it was.
@@ -104,7 +106,7 @@ class Scenario:
         for key in TERRAIN_KEYS:
             if getattr(self, key) == getattr(_OPEN_WORLD, key) or (key == "occlusion" and not self.has_terrain):
                 del values[key]
-        for key in ("weave", "stations", *UNIT_KEYS, *RADIO_DEFAULTS):
+        for key in ("weave", "stations", "watchdog", "watchdog_time", *UNIT_KEYS, *RADIO_DEFAULTS):
             if getattr(self, key) == getattr(_OPEN_WORLD, key):
                 del values[key]
         for key in SAFETY_DEFAULTS:
@@ -212,8 +214,13 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
             resolved[key] = value
         elif key == "controller":
             resolved[key] = _controller_name(value, base)
-        elif key in ("weave", "stations"):
+        elif key in ("weave", "stations", "watchdog"):
             resolved[key] = _boolean(key, value)
+        elif key == "watchdog_time":
+            patience = _number(key, value)
+            if patience < 0.0:
+                raise ScenarioError(f"scenario key 'watchdog_time': expected 0 (automatic) or a positive time, got {value!r}")
+            resolved[key] = patience
         elif key == "half_angle_deg":
             angle = _number(key, value)
             if not 0.0 < angle < 180.0:

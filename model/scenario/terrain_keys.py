@@ -3,7 +3,7 @@
 Checked here, before any process starts; every problem raises :class:`model.scenario.terrain.TerrainError`
 naming the key or the file (the scenario loader reports it as a scenario error).
 
-- ``map = "office.yaml"``: a ROS map, relative to the scenario file. The domain is the map's known extent
+- ``map = "office.yaml"``: a ROS map (or an MRPT ``.gridmap[.gz]``, :mod:`model.scenario.map_file`), relative to the scenario file. The domain is the map's known extent
   (:mod:`model.scenario.map_fit`: the unknown border cropped, padded to whole cells; ``domain``, if given,
   must agree), and the coverage cell is the map's resolution unless ``cell`` says otherwise (a whole number
   of pixels). The model's domain starts at (0, 0) at the fitted map's lower-left corner; what a user reads
@@ -20,8 +20,9 @@ import math
 from pathlib import Path
 from typing import Any
 
+from model.scenario.map_file import load_map
 from model.scenario.map_fit import fit_to_cells
-from model.scenario.terrain import TerrainError, check_polygon, load_occupancy_map
+from model.scenario.terrain import TerrainError, check_polygon
 
 
 def _finite(key: str, value: Any, low: float) -> float:
@@ -37,7 +38,7 @@ def _resolve_map(values: dict[str, Any], base: Path) -> None:
     path = (base / name).resolve()
     if not path.is_file():
         raise TerrainError(f"scenario key 'map': the map file {path} does not exist")
-    occupancy_map = load_occupancy_map(path)
+    occupancy_map = load_map(path)
     values.setdefault("cell", occupancy_map.resolution)
     cell = values["cell"]
     if isinstance(cell, bool) or not isinstance(cell, int | float) or not math.isfinite(cell) or cell <= 0:

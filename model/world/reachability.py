@@ -67,7 +67,7 @@ def coverable_cells(
 
 def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) -> np.ndarray:
     """Each point (K, 2) moved to the centre of the nearest reachable cell, unless its own cell is
-    reachable (then it stays as it is): an objective must lie where a robot can go."""
+    reachable (then it stays as it is)."""
     rows, cols = reachable.shape
     cells = np.argwhere(reachable)
     if len(cells) == 0:
@@ -78,4 +78,50 @@ def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) ->
         row, col = min(max(int(y // cell), 0), rows - 1), min(max(int(x // cell), 0), cols - 1)
         if not reachable[row, col]:
             moved[k] = centres[int(np.argmin(np.hypot(centres[:, 0] - x, centres[:, 1] - y)))]
+    return moved
+
+
+@njit(cache=True)
+def _viewpoint(
+    occupied: np.ndarray, reachable: np.ndarray, x: float, y: float, sensing_range: float, cell: float
+) -> tuple[float, float]:
+    """The centre of the reachable cell nearest to (x, y) that sees it (closer than R, clear sight); the
+    first in row order on a tie; NaN when none does."""
+    rows, cols = occupied.shape
+    span = math.ceil(sensing_range / cell)
+    row, col = math.floor(y / cell), math.floor(x / cell)
+    best, best_x, best_y = math.inf, math.nan, math.nan
+    for r in range(max(row - span, 0), min(row + span + 1, rows)):
+        for c in range(max(col - span, 0), min(col + span + 1, cols)):
+            if not reachable[r, c]:
+                continue
+            cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
+            gap = math.hypot(cx - x, cy - y)
+            if gap >= sensing_range or gap >= best:
+                continue
+            if not segment_crosses_occupied(occupied, cx, cy, x, y, cell):
+                best, best_x, best_y = gap, cx, cy
+    return best_x, best_y
+
+
+def viewpoints(
+    occupied: np.ndarray, reachable: np.ndarray, points: np.ndarray, sensing_range: float, cell: float
+) -> np.ndarray:
+    """Where a robot goes to cover each point (K, 2) (an objective of Algorithm 1, on an uncovered cell): the
+    point itself when its cell is reachable, else the centre of the nearest reachable cell that sees it
+    (closer than R, no wall across: how coverable cells are defined, so a coverable point has one). The
+    nearest reachable cell alone (:func:`nearest_reachable`) may lie behind the wall the point is on: a
+    robot sent there looked at a wall for the rest of the run (issue 34's stalls). A point that no
+    reachable cell sees goes to the nearest reachable cell."""
+    rows, cols = reachable.shape
+    moved = np.array(points, dtype=np.float64, copy=True).reshape(-1, 2)
+    for k, (x, y) in enumerate(moved):
+        row, col = min(max(int(y // cell), 0), rows - 1), min(max(int(x // cell), 0), cols - 1)
+        if reachable[row, col]:
+            continue
+        view_x, view_y = _viewpoint(occupied, reachable, x, y, sensing_range, cell)
+        if view_x == view_x:
+            moved[k] = view_x, view_y
+        else:
+            moved[k] = nearest_reachable(reachable, moved[k : k + 1], cell)[0]
     return moved

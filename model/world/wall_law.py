@@ -68,7 +68,15 @@ def global_law_among_walls(
         ground.bounded,
     )
     detour = waypoint_x != objective_x or waypoint_y != objective_y
-    if (detour and distance > cell) or (not detour and u_glo >= 0.0):
+    if not detour and _covered_cell(coverage, target_ticks, ground, objective_x, objective_y, cell):
+        # A viewpoint (model.world.reachability.viewpoints: a covered cell from which the blob is seen), or a
+        # blob done since the last plan: eq. 10's stop at R/2 frames nothing there (the robot waited R/2 short
+        # of it with what it was sent to see nearly out of range). Go to the point itself, and look there.
+        gap = math.hypot(objective_x - x, objective_y - y)
+        if gap > 0.5 * cell:
+            look[0], look[1] = math.nan, math.nan
+            return global_law_around_walls(x, y, objective_x, objective_y, gap, literal_heading)
+    elif (detour and distance > cell) or (not detour and u_glo >= 0.0):
         look[0], look[1] = math.nan, math.nan  # driving: the next stop looks anew
         if detour:
             return global_law_around_walls(x, y, waypoint_x, waypoint_y, distance, literal_heading)
@@ -82,6 +90,17 @@ def global_law_among_walls(
         # nearer, at eq. 10's speed for this distance taken positive, rather than wait for ever.
         return abs(u_glo), math.atan2(objective_y - y, objective_x - x)
     return 0.0, math.atan2(look_y - y, look_x - x)
+
+
+@njit(cache=True)
+def _covered_cell(
+    coverage: np.ndarray, target_ticks: int, ground: Ground, point_x: float, point_y: float, cell: float
+) -> bool:
+    """Whether the point's cell has nothing left to cover (covered, or a wall)."""
+    rows, cols = coverage.shape
+    row = min(max(math.floor(point_y / cell), 0), rows - 1)
+    col = min(max(math.floor(point_x / cell), 0), cols - 1)
+    return coverage[row, col] >= target_ticks or ground.occupied[row, col]
 
 
 @njit(cache=True)

@@ -29,13 +29,13 @@ from scipy.sparse.csgraph import connected_components
 
 from model.paper.fixed_point import COVERAGE_SCALE
 from model.scenario import Scenario
+from model.scenario.map_file import load_map
 from model.scenario.map_fit import FittedMap, fit_to_cells
 from model.scenario.terrain import (
     OccupancyMap,
     TerrainError,
     coarsen,
     file_sha256,
-    load_occupancy_map,
     polygons_on_grid,
 )
 from model.world.geodesic import distance_fields, grid_graph, passable_cells
@@ -165,7 +165,7 @@ def _priority_ticks(scenario: Scenario, shape: tuple[int, int]) -> tuple[np.ndar
 @functools.lru_cache(maxsize=8)
 def fitted_map_of(scenario: Scenario) -> tuple[OccupancyMap, FittedMap]:
     """The scenario's map as read, and fitted to its cells (:mod:`model.scenario.map_fit`)."""
-    occupancy_map = load_occupancy_map(scenario.map)
+    occupancy_map = load_map(scenario.map)
     return occupancy_map, fit_to_cells(occupancy_map, scenario.cell)
 
 
