@@ -6,6 +6,7 @@
 #   ./go reproduce ARGS    anicov reproduce ... (the paper's experiments)
 #   ./go bench             the benchmarks in bench/
 #   ./go setup             only create or update .venv
+#   ./go maps              fetch the public SLAM maps of scenarios/real/ (./go test does)
 set -euo pipefail
 cd "$(dirname "$0")"
 VENV=.venv
@@ -33,6 +34,7 @@ case "$command" in
     setup) setup ;;
     test)
         setup
+        scenarios/real/fetch_maps.sh  # the public SLAM maps the tests read (from Debian's registry; not committed)
         "$VENV/bin/ruff" check .
         "$VENV/bin/lint-imports"  # the layout's contracts (pyproject.toml [tool.importlinter])
         exec "$VENV/bin/python" -m pytest "$@"
@@ -41,5 +43,6 @@ case "$command" in
     run) setup; exec "$VENV/bin/anicov" run "$@" ;;
     reproduce) setup; exec "$VENV/bin/anicov" reproduce "$@" ;;
     bench) setup; exec "$VENV/bin/python" bench/run_all.py "$@" ;;
-    *) sed -n '2,9p' "$0"; exit 2 ;;
+    maps) exec scenarios/real/fetch_maps.sh ;;
+    *) sed -n '2,10p' "$0"; exit 2 ;;
 esac

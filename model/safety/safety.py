@@ -102,8 +102,11 @@ def filter_command(
     law_omega = omega_hat  # what FILTER_CHANGED compares with, also when the slide turns the nominal
     pressed = wall_x != 0.0 or wall_y != 0.0
     if not binding and pressed and abs(v_hat) > 0.01 * safety.v_max and abs(v) < HELD_FRACTION * abs(v_hat):
-        # Pressed on a wall (the law drives into it and the wall stops it): slide along it (see _slide).
-        omega_hat = _slide(poses[me, 2], wall_x, wall_y, safety)
+        # Pressed on a wall (the law drives into it and the wall stops it): slide along it (see _slide), in
+        # the direction the law drives: a robot reversing into a wall turned by the forward slide until it
+        # faced away from the wall, its back still on it, and stood there for good (issue 34's lab map).
+        travel = poses[me, 2] if v_hat >= 0.0 else poses[me, 2] + math.pi
+        omega_hat = _slide(travel, wall_x, wall_y, safety)
         v, omega, feasible, binding, _, _, _ = safe_velocities(
             v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
         )
