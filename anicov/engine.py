@@ -117,8 +117,7 @@ def run_scenario(
     looks = np.full((scenario.agents, 2), np.nan)  # nothing looked at yet (model.step.no_look)
     planner, block = watched_planner(scenario, controller.planner(scenario)), controller.plan_steps(scenario)
     advance = advance_team if controller.compiled else functools.partial(advance_plugin_team, controller, scenario)
-    agents = scenario.agents
-    traces: list[np.ndarray] = []
+    agents, traces = scenario.agents, []
     errors: list[np.ndarray] = [np.array([coverage_map.domain_error()])]
     snapshot_times, snapshots = [0.0], [quantised_lack(coverage_map.lack_of_coverage())]
     scratch_trace = np.zeros((block, agents, len(TRACE_FIELDS)))
@@ -156,8 +155,7 @@ def run_scenario(
     result = finish_run(
         scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace
     )
-    result.plans = plans
-    result.stalls, result.given_up = list(planner.stalls), planner.given_up()
+    result.plans, result.stalls, result.given_up = plans, list(planner.stalls), planner.given_up()
     result.safety_flags = np.concatenate(flags) if flags else np.zeros((0, agents), dtype=np.uint8)
     return result
 
