@@ -4,8 +4,10 @@ It runs inside the team's planning (:meth:`model.planning.TeamPlanner.plan_watch
 and the coordinator process, which plan at the same steps from the same map, see the same stalls and do the
 same about them (lockstep stays equal to the engine byte for byte).
 
-- **Progress**: the team's lack of coverage Σ Υ (what e_D is, unnormalised) fell since the best seen. A plan
-  that finds no progress for ``patience`` time units while coverable cells remain uncovered is a *stall*.
+- **Progress**: a cell was covered: fewer cells are uncovered than the fewest seen. A plan that finds no
+  progress for ``patience`` time units while coverable cells remain uncovered is a *stall*. (Σ Υ falling is
+  not enough: a robot looking at a cell on the rim of its range, where eq. 2's α is nearly 0, raised it by a
+  tick now and then for 15,000 time units on the lab map of issue 34, and was never called stalled.)
 - **What it says**: for each robot, where it stands, the objective it was given, how far it moved during the
   stall, and why it does not get there or see it (:func:`robot_reasons`).
 - **What it does**: the uncovered cells within R of each robot's objective (what the robot was sent to see)
@@ -27,9 +29,6 @@ import numpy as np
 
 ReasonFunction = Callable[[int, tuple[float, float], tuple[float, float], float], str]
 """(agent, position, objective, path since the last progress) → why the robot made no progress, in words."""
-
-PROGRESS_TOLERANCE = 1e-9
-"""Σ Υ must fall by more than this (relative) to count as progress: rounding is not progress."""
 
 
 @dataclass(frozen=True)
@@ -109,7 +108,7 @@ class ProgressWatchdog:
     patience: float
     sensing_range: float
     cell: float
-    best: float = math.inf
+    best: float = math.inf  # the fewest uncovered cells seen
     since: float = 0.0  # time of the last progress
     set_aside: np.ndarray | None = None  # bool (rows, cols)
     set_aside_until: float = math.inf
@@ -157,13 +156,13 @@ class ProgressWatchdog:
         """Called at every plan with the map and poses of ``time``; acts on a stall and returns it, else None."""
         self._ensure(lack.shape)
         self._track(positions, members)
-        remaining = float(lack.sum())
         uncovered = lack > 0.0
+        remaining = int(uncovered.sum())
         others = uncovered & ~self.set_aside & ~self.given_up
         if self.set_aside.any() and (time >= self.set_aside_until or not others.any()):
             self.set_aside[:] = False  # their turn again
             self.set_aside_until = math.inf
-        if remaining < self.best * (1.0 - PROGRESS_TOLERANCE) or not uncovered.any():
+        if remaining < self.best or not uncovered.any():
             self.best, self.since = remaining, time
             self.moved.clear()
             return None

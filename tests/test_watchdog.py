@@ -30,20 +30,21 @@ def test_the_watchdog_waits_its_patience_then_sets_aside_then_gives_up():
     watchdog = ProgressWatchdog(patience=10.0, sensing_range=1.0, cell=1.0)
     lack = np.zeros((5, 5))
     lack[2, 2] = 0.5
+    lack[0, 4] = 1.0  # far from the objective: never near it, never set aside
     positions, members = np.array([[0.5, 0.5]]), [0]
     assert watchdog.observe(0.0, lack, positions, members, no_reason) is None  # the first sum is progress
     watchdog.remember(np.array([[2.5, 2.5]]), members)
     assert watchdog.observe(5.0, lack, positions, members, no_reason) is None  # within patience
     first = watchdog.observe(10.0, lack, positions, members, no_reason)
     assert first is not None and first.action == "set aside" and first.cells == ((2, 2),)
-    assert watchdog.masked(lack).sum() == 0.0  # planned as if covered: the robots go elsewhere
-    # Nothing else is left, so the cell is back at the next plan; a second stall gives it up.
-    assert watchdog.observe(15.0, lack, positions, members, no_reason) is None
+    assert watchdog.masked(lack)[2, 2] == 0.0  # planned as if covered: the robots go elsewhere
+    lack[0, 4] = 0.5  # Σ Υ falls, but no cell is covered: not progress (a cell on the rim of R crept so)
+    assert watchdog.observe(12.0, lack, positions, members, no_reason) is None and watchdog.since == 10.0
+    lack[0, 4] = 0.0  # a cell covered: progress; now only the set-aside cell is left, so it is back at once
+    assert watchdog.observe(15.0, lack, positions, members, no_reason) is None and watchdog.since == 15.0
     assert watchdog.masked(lack)[2, 2] == 0.5
-    second = watchdog.observe(20.0, lack, positions, members, no_reason)
+    second = watchdog.observe(25.0, lack, positions, members, no_reason)
     assert second is not None and second.action == "given up" and watchdog.only_given_up_left(lack)
-    lack[2, 2] = 0.25  # progress resets the clock
-    assert watchdog.observe(25.0, lack, positions, members, no_reason) is None and watchdog.since == 25.0
 
 
 def stalling_values(**extra):

@@ -15,8 +15,9 @@ from model.paper.assignment import assign_objectives
 from model.paper.objectives import BlobObjectives, fallback_objective, select_objectives
 from model.planning import TeamPlanner, path_lengths
 from model.scenario import Scenario
+from model.world.crowding import spread_shared, team_spacing
 from model.world.reachability import viewpoints
-from model.world.world import world_of
+from model.world.world import viewing_range_of, world_of
 
 
 @dataclass
@@ -32,8 +33,9 @@ class Planner(TeamPlanner):
         A scenario with fixed ``objectives`` gives each robot its own, Algorithms 1–2 do not run.
 
         On a terrain Algorithm 1 runs on the same Υ (cells nobody can cover are at Λ* already), each
-        objective is then moved to where a robot can see it from (:func:`model.world.reachability.viewpoints`)
-        and Algorithm 2 takes the lengths of the shortest free paths to them (:func:`path_lengths`)."""
+        objective is taken at the centre of the blob's cell it was found in, then moved to where a robot can see it from (:func:`model.world.reachability.viewpoints`)
+        and Algorithm 2 takes the lengths of the shortest free paths to them (:func:`path_lengths`); robots with
+        bodies that share an objective each get a place of their own (:mod:`model.world.crowding`)."""
         if self.scenario.objectives:
             ids = range(len(positions)) if members is None else members
             return np.array([self.scenario.objectives[agent] for agent in ids], dtype=np.float64).reshape(-1, 2)
@@ -48,5 +50,13 @@ class Planner(TeamPlanner):
             objectives = fallback[None, :]
         if not terrain:
             return objectives[assign_objectives(positions, objectives)]
-        objectives = viewpoints(world.occupied, world.reachable, objectives, self.scenario.range, self.scenario.cell)
-        return objectives[assign_objectives(positions, objectives, path_lengths(world, positions, objectives))]
+        if len(self.blobs.positions) and self.blobs.cells is not None:
+            objectives = (self.blobs.cells[:, ::-1] + 0.5) * self.scenario.cell  # each blob's own cell (BlobObjectives.cells)
+        places = viewpoints(
+            world.occupied, world.reachable, objectives, viewing_range_of(self.scenario), self.scenario.cell
+        )
+        lengths = path_lengths(world, positions, places)
+        choice = assign_objectives(positions, places, lengths)
+        if (spacing := team_spacing(self.scenario)) > 0.0:
+            return spread_shared(world, objectives, places, choice, lengths, positions, spacing)
+        return places[choice]

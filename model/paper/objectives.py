@@ -39,6 +39,10 @@ class BlobObjectives:
 
     positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     labels: np.ndarray | None = None
+    cells: np.ndarray | None = None
+    """(M, 2) int (row, col): the blob's cell each objective was found in (line 18's test: the centroid
+    rounded to a cell). A centroid may lie on a cell's edge or corner, so the cell its point falls in
+    (:func:`cell_of`) can be another cell, even a wall's; a viewpoint on a terrain is found for this one."""
 
     @property
     def count(self) -> int:
@@ -77,11 +81,14 @@ def select_objectives(
     kept = _keep_objectives(previous, lack, cell, merge_distance) if previous.count else []
     labels = np.zeros(lack.shape, dtype=np.int32)
     positions: list[np.ndarray] = []
+    cells: list[tuple[int, int]] = []
     if kept and previous.labels is not None:
         relabel = np.zeros(previous.count + 1, dtype=np.int32)
         for new_index, j in enumerate(kept):
             relabel[j + 1] = new_index + 1
             positions.append(previous.positions[j])
+            known = previous.cells is not None and len(previous.cells) == previous.count
+            cells.append(tuple(previous.cells[j]) if known else cell_of(previous.positions[j], cell, lack.shape))
         labels = relabel[previous.labels]
 
     uncovered = lack > 0.0
@@ -99,25 +106,31 @@ def select_objectives(
             labels[top : top + height, left : left + width][window] = label
             blob_domain[top : top + height, left : left + width][window] = 0
             positions.append(np.array([(cx + 0.5) * cell, (cy + 0.5) * cell]))
+            cells.append((row, col))
         blob_domain = cv2.erode(blob_domain, _ERODE_KERNEL)
 
     eroded = uncovered & (labels == 0)
     if by_paths and eroded.any():
-        labels = by_paths_through(uncovered, labels, eroded, positions, cell)
+        labels = by_paths_through(uncovered, labels, eroded, positions, cell, cells)
     elif positions and eroded.any():
         _, nearest = ndimage.distance_transform_edt(labels == 0, return_indices=True)
         labels[eroded] = labels[nearest[0][eroded], nearest[1][eroded]]
     stacked = np.array(positions, dtype=np.float64).reshape(-1, 2)
-    return BlobObjectives(positions=stacked, labels=labels)
+    return BlobObjectives(positions=stacked, labels=labels, cells=np.array(cells, dtype=np.int64).reshape(-1, 2))
 
 
 def by_paths_through(
-    uncovered: np.ndarray, labels: np.ndarray, eroded: np.ndarray, positions: list[np.ndarray], cell: float
+    uncovered: np.ndarray,
+    labels: np.ndarray,
+    eroded: np.ndarray,
+    positions: list[np.ndarray],
+    cell: float,
+    cells: list[tuple[int, int]] | None = None,
 ) -> np.ndarray:
     """Line 25 on a terrain: each eroded cell takes the label of the blob that reaches it first by
     8-connected steps through uncovered cells (a wavefront from every blob at once; the larger label on
     a tie, so every replica gets the same); each region of eroded cells no blob reaches becomes a blob of
-    its own, its objective (appended to ``positions``) the region's cell nearest its centroid (the
+    its own, its objective (appended to ``positions``, its cell to ``cells``) the region's cell nearest its centroid (the
     first in row order on a tie), so that every uncovered cell has an objective on its own side of the
     walls. Returns the new labels."""
     reached = labels.copy()
@@ -135,6 +148,8 @@ def by_paths_through(
         nearest = int(np.argmin((rows - rows.mean()) ** 2 + (cols - cols.mean()) ** 2))
         labels[rows, cols] = len(positions) + 1
         positions.append(np.array([(cols[nearest] + 0.5) * cell, (rows[nearest] + 0.5) * cell]))
+        if cells is not None:
+            cells.append((int(rows[nearest]), int(cols[nearest])))
     return labels
 
 

@@ -69,10 +69,11 @@ DETOUR_STEPS = 100
 YIELD_STEPS = 20
 """Steps a robot yielding to a lower-id teammate drives away from it (2 time units at dt = 0.1)."""
 
-HELD, DETOUR, YIELDING = 0, 1, 2
-MEMORY_SIZE = 3
-"""A robot's deadlock state (``memory``): steps held so far, steps of the detour under way, and whether
-that detour is a yield (1) or keeping right (0)."""
+HELD, DETOUR, YIELDING, TURNING, TURNING_OUT = 0, 1, 2, 3, 4
+MEMORY_SIZE = 5
+"""A robot's deadlock state (``memory``): steps held so far, steps of the detour under way, whether
+that detour is a yield (1) or keeping right (0), the way (+1 left, −1 right, 0 none) of a turn in
+place taken the long way round (:func:`_other_way`), and whether that turn is a deadlock's way out (1)."""
 
 
 @njit(cache=True)
@@ -111,6 +112,10 @@ def filter_command(
             v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
         )
     flags = 0
+    if memory[DETOUR] == 0:
+        v, omega, feasible, omega_hat, flags = _other_way(
+            v_hat, omega_hat, v, omega, feasible, binding, me, poses, ages, kinds, ground, cell, safety, memory
+        )
     if memory[DETOUR] > 0:  # a detour under way: yielding or keeping right
         passes = feasible and not _held(v_hat, omega_hat, v, omega, binding, safety)
         v, omega, feasible, flags = _detour(
@@ -119,15 +124,10 @@ def filter_command(
     elif binding and _held(v_hat, omega_hat, v if feasible else 0.0, omega if feasible else 0.0, binding, safety):
         memory[HELD] += 1
         if memory[HELD] >= STUCK_STEPS:
-            memory[HELD] = 0
-            memory[DETOUR] = 1
-            flags |= DEADLOCK_FOUND
-            turning = abs(v_hat) < safety.lookahead * abs(omega_hat)
-            away_x, away_y = _yield_direction(me, poses, safety)
-            if turning and (away_x != 0.0 or away_y != 0.0):
-                memory[YIELDING] = 1
-                flags |= KEEPING_RIGHT
-                v, omega, feasible = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
+            v, omega, feasible, found = _deadlock(
+                v_hat, omega_hat, v, omega, feasible, me, poses, ages, kinds, ground, cell, safety, memory
+            )
+            flags |= found
     else:
         memory[HELD] = 0
     if not feasible:
@@ -135,6 +135,124 @@ def filter_command(
     if abs(v - v_hat) + safety.lookahead * abs(omega - law_omega) > 1e-12 * (1.0 + abs(v_hat)):
         flags |= FILTER_CHANGED
     return v, omega, flags
+
+
+@njit(cache=True)
+def _deadlock(
+    v_hat: float,
+    omega_hat: float,
+    v: float,
+    omega: float,
+    feasible: bool,
+    me: int,
+    poses: np.ndarray,
+    ages: np.ndarray,
+    kinds: np.ndarray,
+    ground: Ground,
+    cell: float,
+    safety: SafetyParameters,
+    memory: np.ndarray,
+) -> tuple[float, float, bool, int]:
+    """A deadlock found (held STUCK_STEPS): its first step, (v, ω, feasible, flags). A robot turning in place
+    yields when its nearest teammate has the lower id; else, its teammate being the one to give way and this
+    one still held, it turns the long way round if that way is free (:func:`_other_way`); anything else
+    keeps right (a detour)."""
+    memory[HELD] = 0
+    memory[DETOUR] = 1
+    flags = DEADLOCK_FOUND
+    turning = abs(v_hat) < safety.lookahead * abs(omega_hat)
+    away_x, away_y = _yield_direction(me, poses, safety)
+    if turning and (away_x != 0.0 or away_y != 0.0):
+        memory[YIELDING] = 1
+        v, omega, feasible = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
+        return v, omega, feasible, flags | KEEPING_RIGHT
+    if turning:
+        v_other, omega_other, feasible_other, turns = _long_way(
+            v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, memory
+        )
+        if turns:
+            memory[DETOUR], memory[TURNING_OUT] = 0, 1
+            return v_other, omega_other, feasible_other, flags
+    return v, omega, feasible, flags
+
+
+@njit(cache=True)
+def _other_way(
+    v_hat: float,
+    omega_hat: float,
+    v: float,
+    omega: float,
+    feasible: bool,
+    binding: bool,
+    me: int,
+    poses: np.ndarray,
+    ages: np.ndarray,
+    kinds: np.ndarray,
+    ground: Ground,
+    cell: float,
+    safety: SafetyParameters,
+    memory: np.ndarray,
+) -> tuple[float, float, bool, float, int]:
+    """A turn in place the filter holds, taken the long way round: (v, ω, feasible, the nominal ω now, flags).
+
+    A robot turning in place (|v̂| < l·|ω̂|: at its objective, looking) moves its look-ahead point sideways,
+    and a teammate's barrier at its side, with a wall ahead holding v at 0, forbids one way of turning and
+    not the other: the QP's nearest command was then no turn at all, for good (issue 34, the lab map:
+    two robots at a door, each with its back to the other). Turning the other way gets there too (eq. 16
+    asks k_ω times the angle; the long way is at least π, so π·k_ω, the bound).
+
+    A robot that would give way to its teammate (:func:`_yield_direction`) turns the long way at once when
+    it cannot: its drive away is held too (a wall), or no teammate's constraint binds its own command (no
+    deadlock would ever be found). The other starts at a deadlock (:func:`filter_command`). The turn is
+    kept (``memory``) until the law itself turns that way (past the far side) or stops turning in place,
+    or the long way is held too. A deadlock's way out that ends so, not held, is a deadlock resolved."""
+    ahead = safety.lookahead
+    in_place = abs(v_hat) < ahead * abs(omega_hat) and ahead * abs(omega_hat) > WANTS_TO_MOVE * safety.v_max
+    if not in_place or omega_hat * memory[TURNING] > 0.0:
+        flags = DEADLOCK_RESOLVED if memory[TURNING] != 0 and memory[TURNING_OUT] == 1 else 0
+        memory[TURNING] = memory[TURNING_OUT] = 0
+        return v, omega, feasible, omega_hat, flags
+    if memory[TURNING] == 0:
+        if feasible and omega * omega_hat > 0.0 and abs(omega) >= HELD_FRACTION * abs(omega_hat):
+            return v, omega, feasible, omega_hat, 0  # it turns as asked
+        away_x, away_y = _yield_direction(me, poses, safety)
+        if away_x == 0.0 and away_y == 0.0:
+            return v, omega, feasible, omega_hat, 0  # the teammate, of the higher id, gives way (or none is near)
+        v_away, omega_away, feasible_away = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
+        if binding and feasible_away and math.hypot(v_away, ahead * omega_away) >= HELD_FRACTION * safety.v_max:
+            return v, omega, feasible, omega_hat, 0  # it can give way: the deadlock's yield does that
+    v_other, omega_other, feasible_other, turns = _long_way(
+        v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, memory
+    )
+    if turns:
+        return v_other, omega_other, feasible_other, omega_other, 0
+    return v, omega, feasible, omega_hat, 0
+
+
+@njit(cache=True)
+def _long_way(
+    v_hat: float,
+    omega_hat: float,
+    me: int,
+    poses: np.ndarray,
+    ages: np.ndarray,
+    kinds: np.ndarray,
+    ground: Ground,
+    cell: float,
+    safety: SafetyParameters,
+    memory: np.ndarray,
+) -> tuple[float, float, bool, bool]:
+    """The safe command for turning the long way round (the way in ``memory``, else against ω̂) at the bound,
+    and whether it turns that way at HELD_FRACTION of |ω̂| or more: then ``memory`` keeps the way, else 0."""
+    way = memory[TURNING] if memory[TURNING] != 0 else (-1 if omega_hat > 0.0 else 1)
+    v, omega, feasible, _, _, _, _ = safe_velocities(
+        v_hat, way * safety.omega_max, me, poses, ages, kinds, ground, cell, safety, 0.0
+    )
+    turns = feasible and omega * way >= HELD_FRACTION * abs(omega_hat)
+    memory[TURNING] = way if turns else 0
+    if not turns:
+        memory[TURNING_OUT] = 0
+    return v, omega, feasible, turns
 
 
 @njit(cache=True)

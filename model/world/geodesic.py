@@ -77,6 +77,11 @@ def distance_fields(
     return np.asarray(fields).reshape(len(goals), rows, cols)
 
 
+OWN_CLEARANCE_SLACK = 1e-9
+"""How much of its own clearance, in cells, a robot inside the planning margin leaves out of the drive's disk
+test (:func:`in_sight`): far above rounding, far below anything a robot could hit."""
+
+
 @njit(cache=True)
 def in_sight(
     occupied: np.ndarray,
@@ -91,11 +96,16 @@ def in_sight(
     """A straight drive from (x, y) to the target crosses no occupied cell and keeps the disk of ``radius``
     free, or, where the robot already stands closer to a wall than that, a disk of its clearance there:
     a robot inside the planning margin may still drive on (else every drive would be refused there,
-    and its waypoint would jump between cells from one step to the next)."""
+    and its waypoint would jump between cells from one step to the next). That clearance is taken a hair
+    short (OWN_CLEARANCE_SLACK): measured from the very point the drive starts at, rounding made the start
+    itself fail the test, and a robot the filter held exactly r + s off a door's jamb found no drive at all
+    and headed straight into the jamb for the rest of the run (issue 34, the lab map, N = 2 seed 4)."""
     if segment_crosses_occupied(occupied, x, y, target_x, target_y, cell):
         return False
-    radius = clearance_within(occupied, x, y, radius, cell, bounded)
-    return radius <= 0.0 or swept_disk_is_free(occupied, x, y, target_x, target_y, radius, cell, bounded)
+    clearance = clearance_within(occupied, x, y, radius, cell, bounded)
+    if clearance < radius:
+        clearance -= OWN_CLEARANCE_SLACK * cell
+    return clearance <= 0.0 or swept_disk_is_free(occupied, x, y, target_x, target_y, clearance, cell, bounded)
 
 
 @njit(cache=True)

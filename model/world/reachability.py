@@ -2,7 +2,8 @@
 
 A pose is reachable when its cell is passable (:func:`model.world.geodesic.passable_cells`) and connected to
 a robot's start through passable cells (the 8-connected graph of :mod:`model.world.geodesic`, no corner
-cutting). A free cell is coverable when its centre lies closer than R to the centre of a reachable
+cutting). A free cell is coverable when its centre lies closer than the viewing range (R less a cell:
+:func:`model.world.world.viewing_range_of`, passed in as ``sensing_range``) to the centre of a reachable
 cell with a clear line of sight (:func:`model.world.visibility.segment_crosses_occupied`): the robot can turn
 its camera any way, and eq. 2 gives α = 0 at r = R. Occupied cells and the rest of the free cells
 (an enclosed room, a pocket narrower than the robot) are left out of e_D and of completion.
@@ -82,34 +83,35 @@ def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) ->
 
 
 @njit(cache=True)
-def _viewpoint(
+def seers(
     occupied: np.ndarray, reachable: np.ndarray, x: float, y: float, sensing_range: float, cell: float
-) -> tuple[float, float]:
-    """The centre of the reachable cell nearest to (x, y) that sees it (closer than R, clear sight); the
-    first in row order on a tie; NaN when none does."""
+) -> np.ndarray:
+    """The reachable cells that see the point (x, y): closer than R, clear sight from the centre, as
+    coverable cells are defined. (M, 3) rows (gap, centre x, centre y), nearest first, row order on a tie."""
     rows, cols = occupied.shape
     span = math.ceil(sensing_range / cell)
     row, col = math.floor(y / cell), math.floor(x / cell)
-    best, best_x, best_y = math.inf, math.nan, math.nan
+    found = np.empty(((2 * span + 1) ** 2, 3))
+    count = 0
     for r in range(max(row - span, 0), min(row + span + 1, rows)):
         for c in range(max(col - span, 0), min(col + span + 1, cols)):
             if not reachable[r, c]:
                 continue
             cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
             gap = math.hypot(cx - x, cy - y)
-            if gap >= sensing_range or gap >= best:
-                continue
-            if not segment_crosses_occupied(occupied, cx, cy, x, y, cell):
-                best, best_x, best_y = gap, cx, cy
-    return best_x, best_y
+            if gap < sensing_range and not segment_crosses_occupied(occupied, cx, cy, x, y, cell):
+                found[count, 0], found[count, 1], found[count, 2] = gap, cx, cy
+                count += 1
+    order = np.argsort(found[:count, 0], kind="mergesort")  # stable: row order on a tie
+    return found[:count][order]
 
 
 def viewpoints(
     occupied: np.ndarray, reachable: np.ndarray, points: np.ndarray, sensing_range: float, cell: float
 ) -> np.ndarray:
     """Where a robot goes to cover each point (K, 2) (an objective of Algorithm 1, on an uncovered cell): the
-    point itself when its cell is reachable, else the centre of the nearest reachable cell that sees it
-    (closer than R, no wall across: how coverable cells are defined, so a coverable point has one). The
+    point itself when its cell is reachable, else the centre of the nearest reachable cell that sees its cell's
+    centre (closer than R, no wall across: how coverable cells are defined, so a coverable cell has one). The
     nearest reachable cell alone (:func:`nearest_reachable`) may lie behind the wall the point is on: a
     robot sent there looked at a wall for the rest of the run (issue 34's stalls). A point that no
     reachable cell sees goes to the nearest reachable cell."""
@@ -119,9 +121,12 @@ def viewpoints(
         row, col = min(max(int(y // cell), 0), rows - 1), min(max(int(x // cell), 0), cols - 1)
         if reachable[row, col]:
             continue
-        view_x, view_y = _viewpoint(occupied, reachable, x, y, sensing_range, cell)
-        if view_x == view_x:
-            moved[k] = view_x, view_y
+        # From the cell's centre: coverable cells are those a reachable centre sees centre to centre, and
+        # a viewpoint of a point off the centre (Algorithm 1's centroid) may see that point but not the cell.
+        centre_x, centre_y = (col + 0.5) * cell, (row + 0.5) * cell
+        seen_from = seers(occupied, reachable, centre_x, centre_y, sensing_range, cell)
+        if len(seen_from):
+            moved[k] = seen_from[0, 1:]
         else:
             moved[k] = nearest_reachable(reachable, moved[k : k + 1], cell)[0]
     return moved

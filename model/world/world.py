@@ -6,7 +6,8 @@
 - ``reachable``: the team's space, the largest 8-connected component of passable cells (lowest
   cell index on a tie). Every robot starts there (:func:`model.parameters.free_initial_poses`), so
   it is where any robot can go.
-- ``coverable``: free cells some reachable pose can see (:mod:`model.world.reachability`). The others,
+- ``coverable``: free cells some reachable pose can see (:mod:`model.world.reachability`), within
+  :func:`viewing_range_of`. The others,
   occupied or not, start at Λ* in every replica (Υ = 0): Algorithm 1 never sees them, and e_D and
   completion count only coverable cells.
 - ``targets``: Λ*(x) per cell in ticks, from the priority map when there is one.
@@ -127,6 +128,15 @@ class World:
         return report
 
 
+def viewing_range_of(scenario: Scenario) -> float:
+    """How near a cell must lie to a reachable cell's centre, in clear sight, to count as coverable (and to be
+    a viewpoint of it): R less a cell, never under R/2 (eq. 10's stop). A robot sent to a cell stops anywhere
+    within half a cell of its centre, and eq. 2's α falls to 0 at R: on the lab map of issue 34 a cell seen
+    only from 1.4998 of R = 1.5 held a single robot, looking at it, for 15,000 time units. At R less a cell,
+    α ≥ α_max·(cell/2)/R wherever the robot stops (aimed at the cell)."""
+    return max(scenario.range - scenario.cell, 0.5 * scenario.range)
+
+
 def plan_radius_of(scenario: Scenario) -> float:
     """The robot's radius plus the planning margin: what passable cells and straight drives keep free.
     With the safety filter on, its margin too: the filter keeps the disk s off every wall (model.safety.safety),
@@ -215,5 +225,5 @@ def world_of(scenario: Scenario) -> World:
     if not reachable.any():
         raise TerrainError(f"{where}: no free place holds a robot of radius {scenario.robot_radius}")
     start = tuple(int(v) for v in np.argwhere(reachable)[0])
-    coverable = coverable_cells(occupied, passable, [start], scenario.range, scenario.cell)
+    coverable = coverable_cells(occupied, passable, [start], viewing_range_of(scenario), scenario.cell)
     return World(scenario, occupied, passable, reachable, coverable, targets, map_sha, priority_sha)

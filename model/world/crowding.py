@@ -1,0 +1,92 @@
+"""Robots with bodies that Algorithm 2 sends to one objective: each to a place of its own.
+
+Algorithm 2 gives each objective ⌊N/M⌋ to ⌈N/M⌉ robots, and at the end of a run one or two blobs are left
+for the whole team. Point robots in the open share a point harmlessly. Robots with bodies on a map do not:
+on the lab map of issue 34 every team of 2 to 8 that did not finish ended with its robots queued in a
+passage one robot wide toward one viewpoint, the first unable to turn to the blob with a teammate's
+barrier at its back and a wall ahead, the others held behind it, for good.
+
+So on a terrain with bodies (:func:`team_spacing` > 0), of the robots that share an objective the one with
+the shortest free path goes to its viewpoint (:func:`model.world.reachability.viewpoints`), and each of the
+others to the nearest other reachable cell that sees the same target (:func:`model.world.reachability.seers`)
+at least the spacing from every place already given; a robot for which no such cell is left stays clear of
+them: where it is, or the nearest reachable cell that is far enough from all of them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from model.scenario import Scenario
+from model.world.ground import PLANNING_MARGIN
+from model.world.reachability import seers
+from model.world.world import World, viewing_range_of
+
+
+def team_spacing(scenario: Scenario) -> float:
+    """How far apart the places given to robots that share an objective are: what the safety filter keeps
+    between two robots' look-ahead points (2r + s + 2l) plus a cell, as a robot stops anywhere within
+    half a cell of its place; with the filter off, the bodies (2r) plus a cell. 0 for point robots: the
+    paper's robots share objectives as Algorithm 2 has it."""
+    if scenario.robot_radius <= 0.0:
+        return 0.0
+    clearance = 2.0 * scenario.robot_radius
+    if scenario.filters:
+        clearance += scenario.safety_margin + 2.0 * scenario.lookahead
+    return clearance + scenario.cell + PLANNING_MARGIN * scenario.cell
+
+
+def spread_shared(
+    world: World,
+    targets: np.ndarray,
+    places: np.ndarray,
+    choice: np.ndarray,
+    lengths: np.ndarray,
+    positions: np.ndarray,
+    spacing: float,
+) -> np.ndarray:
+    """The place (x, y) of every robot, (N, 2). ``targets`` (M, 2): Algorithm 1's objectives (what to see);
+    ``places`` (M, 2): their viewpoints; ``choice`` (N,): Algorithm 2's objective of each robot; ``lengths``
+    (N, M): the free paths' lengths from each robot to each viewpoint. An objective's first robot (shortest
+    path, then lowest id) gets its viewpoint; then the others, in the same order, their own places."""
+    goals = places[choice].copy()
+    order = sorted(range(len(choice)), key=lambda i: (lengths[i, choice[i]], i))
+    first = {int(choice[i]): i for i in reversed(order)}
+    taken = [places[j] for j in sorted(first)]
+    for i in order:
+        j = int(choice[i])
+        if first[j] == i:
+            continue
+        goals[i] = _own_place(world, targets[j], positions[i], taken, spacing)
+        taken.append(goals[i])
+    return goals
+
+
+def _clear_of(point: np.ndarray, taken: list[np.ndarray], spacing: float) -> bool:
+    return all(math.hypot(point[0] - other[0], point[1] - other[1]) >= spacing for other in taken)
+
+
+def _own_place(
+    world: World, target: np.ndarray, position: np.ndarray, taken: list[np.ndarray], spacing: float
+) -> np.ndarray:
+    """The nearest reachable cell that sees ``target`` and is clear of every place taken; with none left,
+    the robot's own position if it is clear of them, else the nearest reachable cell centre that is."""
+    cell, sensing_range = world.scenario.cell, viewing_range_of(world.scenario)
+    row, col = math.floor(target[1] / cell), math.floor(target[0] / cell)
+    centre_x, centre_y = (col + 0.5) * cell, (row + 0.5) * cell  # what coverable means (viewpoints does the same)
+    for _, x, y in seers(world.occupied, world.reachable, centre_x, centre_y, sensing_range, cell):
+        if _clear_of(np.array((x, y)), taken, spacing):
+            return np.array((x, y))
+    if _clear_of(position, taken, spacing):
+        return position.copy()
+    rows, cols = np.nonzero(world.reachable)
+    centres = np.column_stack(((cols + 0.5) * cell, (rows + 0.5) * cell))
+    clear = np.ones(len(centres), dtype=bool)
+    for other in taken:
+        clear &= np.hypot(centres[:, 0] - other[0], centres[:, 1] - other[1]) >= spacing
+    if not clear.any():
+        return position.copy()
+    candidates = centres[clear]
+    return candidates[int(np.argmin(np.hypot(candidates[:, 0] - position[0], candidates[:, 1] - position[1])))]
