@@ -178,8 +178,12 @@ class AgentNode:
 
     def ends_on_its_own(self) -> bool:
         """Realtime, local planning: end the run here when RadioLink.ends_now says so."""
-        if self.finished is None and self.radio.ends_now(self.replica.map.complete):
-            log.info("agent %d: its replica is complete and no coordinator ended the run: it ends", self.options.agent)
+        if self.finished is None and self.radio.ends_now(self.replica.map):
+            log.info(
+                "agent %d: its replica is complete (or all it has left was given up by its watchdog) and no "
+                "coordinator ended the run: it ends",
+                self.options.agent,
+            )
             self.finished = RunControl("done", self.step, True, self.replica.map.domain_error(), reason="local")
             return True
         return False

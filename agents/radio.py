@@ -9,6 +9,8 @@ import time
 import numpy as np
 
 from model.controllers import controller_of
+from model.paper.coverage_map import CoverageMap
+from model.planning import watched_planner
 from model.scenario import Scenario
 from protocol.messages import AgentState, Pose
 from protocol.recovery import HISTORY_STEPS, RELAY_STEPS
@@ -27,7 +29,9 @@ class RadioLink:
         self.me = me
         self.heard_live = np.full(scenario.agents, -np.inf)  # when each teammate was last heard (monotonic)
         self.out_of_range = 0  # teammates' steps the radio did not deliver
-        self.planner = controller_of(scenario).planner(scenario) if scenario.planning == "local" else None
+        # Local planning: the robot's own planner, with its own progress watchdog (model.watchdog).
+        local = scenario.planning == "local"
+        self.planner = watched_planner(scenario, controller_of(scenario).planner(scenario)) if local else None
         self.planned_at = -(10**9)  # local planning: the step of the last plan
         self.complete_since: float | None = None  # local planning, realtime: when our replica became complete
 
@@ -69,15 +73,20 @@ class RadioLink:
         assert self.planner is not None
         members = sorted(set(members) | {self.me})
         where = np.array([pose[:2] if agent == self.me else positions[agent] for agent in members])
-        targets = self.planner.plan(lack, where, members)
+        targets = self.planner.plan(step * self.scenario.dt, lack, where, members)
         self.planned_at = step
         mine = targets[members.index(self.me)]
         return float(mine[0]), float(mine[1])
 
-    def ends_now(self, complete: bool) -> bool:
-        """Local planning: our replica is ``complete`` (so the world is) and has been for LOCAL_END_WAIT
-        seconds without the coordinator ending the run (it is gone)."""
-        if self.planner is None or not complete:
+    def ends_now(self, replica: CoverageMap) -> bool:
+        """Local planning: our ``replica`` is complete (so the world is), or our watchdog gave up every cell it
+        has left, and has been for LOCAL_END_WAIT seconds without the coordinator ending the run (it is gone)."""
+        if self.planner is None:
+            return False
+        given_up = self.planner.given_up()
+        if not replica.complete and (
+            given_up is None or not given_up.any() or not self.planner.only_given_up_left(replica.lack_of_coverage())
+        ):
             return False
         now = time.monotonic()
         if self.complete_since is None:

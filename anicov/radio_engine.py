@@ -21,12 +21,13 @@ from anicov.run_parts import finish_run, objective_fields
 from model.controllers import controller_of, law_parameters
 from model.paper.coverage_map import CoverageMap
 from model.parameters import safety_parameters
-from model.planning import Plan, TeamPlanner
+from model.planning import Plan, WatchedPlanner, watched_planner
 from model.radio.radio import contacts, divergence, local_members, merge_knowledge
 from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack
 from model.safety.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move
+from model.watchdog import Stall
 from model.world.world import World, world_of
 
 Window = tuple[int, int, np.ndarray]
@@ -97,22 +98,21 @@ def run_ranged(
     agents = scenario.agents
     team = RadioTeam(coverage_map, agents)
     controller = controller_of(scenario)
-    central = controller.planner(scenario)
-    planners = [controller.planner(scenario) for _ in range(agents)]
-    rows: list[np.ndarray] = []
-    flags: list[np.ndarray] = []
-    errors = [coverage_map.domain_error()]
+    # Each with its progress watchdog (model.watchdog), as the engine's and the coordinator's planner has.
+    central = watched_planner(scenario, controller.planner(scenario))
+    planners = [watched_planner(scenario, controller.planner(scenario)) for _ in range(agents)]
+    rows, flags, errors = [], [], [coverage_map.domain_error()]
     snapshot_times, snapshots = [0.0], [quantised_lack(coverage_map.lack_of_coverage())]
     plans: list[Plan] = []
-    objectives = np.zeros((agents, 2))
-    fields = np.zeros((agents, 1, 1))
-    next_snapshot = SNAPSHOT_PERIOD
-    step = 0
+    objectives, fields = np.zeros((agents, 2)), np.zeros((agents, 1, 1))
+    next_snapshot, step = SNAPSHOT_PERIOD, 0
     while step < scenario.max_steps and not coverage_map.complete:
         positions = poses[:, :2].copy()
         in_contact = contacts(positions, scenario.comm_range)
         if step % scenario.plan_steps == 0:
-            objectives = plan_objectives(scenario, team, central, planners, positions, in_contact)
+            if only_given_up_left(scenario, team, central, planners):
+                break  # the watchdog gave up every cell left (every robot's, planning locally)
+            objectives = plan_objectives(scenario, team, central, planners, positions, in_contact, step)
             fields = objective_fields(world, objectives)
             if record_trace:
                 plans.append(record_plan(scenario, central, step, objectives))
@@ -139,6 +139,7 @@ def run_ranged(
         scenario, coverage_map, poses, chunks, [np.array(errors)], step, snapshot_times, snapshots, record_trace
     )
     result.plans = plans
+    result.stalls, result.given_up = watchdog_outcome(scenario, central, planners)
     result.safety_flags = np.stack(flags) if flags else np.zeros((0, agents), dtype=np.uint8)
     result.radio = team.figures()
     return result
@@ -181,25 +182,52 @@ def decide_team(
 def plan_objectives(
     scenario: Scenario,
     team: RadioTeam,
-    central: TeamPlanner,
-    planners: list[TeamPlanner],
+    central: WatchedPlanner,
+    planners: list[WatchedPlanner],
     positions: np.ndarray,
     in_contact: np.ndarray,
+    step: int,
 ) -> np.ndarray:
     """(N, 2): central, Algorithms 1-2 on the union for everyone; local, each robot's own objective from
     its replica and the teammates it hears (:func:`model.radio.radio.local_members`)."""
+    now = step * scenario.dt
     if scenario.planning == "central":
-        return central.plan(team.union.lack_of_coverage(), positions)
+        return central.plan(now, team.union.lack_of_coverage(), positions)
     objectives = np.zeros((len(positions), 2))
     for me, planner in enumerate(planners):
         members = local_members(me, in_contact)
-        mine = planner.plan(team.replicas[me].lack_of_coverage(), positions[members], members)
+        mine = planner.plan(now, team.replicas[me].lack_of_coverage(), positions[members], members)
         objectives[me] = mine[members.index(me)]
     return objectives
 
 
-def record_plan(scenario: Scenario, central: TeamPlanner, step: int, objectives: np.ndarray) -> Plan:
+def only_given_up_left(
+    scenario: Scenario, team: RadioTeam, central: WatchedPlanner, planners: list[WatchedPlanner]
+) -> bool:
+    """The run is over: central, every cell left was given up by the watchdog; local, every robot's own
+    watchdog gave up every cell its replica has left (a cell left in the world is left in every replica)."""
+    if scenario.planning == "central":
+        return central.only_given_up_left(team.union.lack_of_coverage())
+    return all(
+        planner.only_given_up_left(replica.lack_of_coverage())
+        for planner, replica in zip(planners, team.replicas, strict=True)
+    )
+
+
+def watchdog_outcome(
+    scenario: Scenario, central: WatchedPlanner, planners: list[WatchedPlanner]
+) -> tuple[list[Stall], np.ndarray | None]:
+    """(stalls, cells given up): central, its watchdog's; local, every robot's, in time order, and the
+    cells any of them gave up."""
+    if scenario.planning == "central":
+        return list(central.stalls), central.given_up()
+    stalls = sorted((stall for planner in planners for stall in planner.stalls), key=lambda stall: stall.time)
+    given = [planner.given_up() for planner in planners if planner.given_up() is not None]
+    return stalls, (np.logical_or.reduce(given) if given else None)
+
+
+def record_plan(scenario: Scenario, central: WatchedPlanner, step: int, objectives: np.ndarray) -> Plan:
     """The plan as the recording keeps it; local planning has no one team's blobs to draw."""
     if scenario.planning == "central":
-        return central.record(step, objectives)
+        return central.planner.record(step, objectives)
     return (step, tuple(range(len(objectives))), objectives.copy(), np.zeros((0, 2)), None)

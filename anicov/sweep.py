@@ -13,7 +13,7 @@ A sweep file::
 
 writes ``OUT/runs.csv``: one row per run, with every grid key, the seed and every figure of the run's
 summary (completed, completion_time, optimum_time, time_ratio, steps, team_path_length, final_error,
-the safety figures when robots have a body, the radio's with a limited
+the safety figures when robots have a body, the watchdog's interventions and cells given up, the radio's with a limited
 comm_range or local planning). Each row is written and flushed as its run ends, so a
 sweep killed at any point loses at most the runs under way; started again on the same OUT it reads the
 table (a last line cut by the kill is dropped), runs only what is missing and says how many it found.
@@ -52,6 +52,8 @@ FIGURES = (
     "min_clearance",
     "filter_active_fraction",
     "deadlocks",
+    "watchdog_interventions",
+    "cells_given_up",
     "divergence_mean",
     "divergence_max",
     "teammates_heard_mean",
@@ -136,6 +138,12 @@ def run_point(sweep: Sweep, point: dict[str, Any]) -> dict[str, Any]:
     # The safety figures read the whole trace (robots with a body); the rest need only the path lengths.
     summary = summary_of(run_scenario(scenario, record_trace=scenario.robot_radius > 0.0))
     figures = summary | summary.get("radio", {})
+    if scenario.watchdog:  # what the progress watchdog did (model.watchdog; summary.json reports it when it acted)
+        report = summary.get("watchdog") or {}
+        figures |= {
+            "watchdog_interventions": len(report.get("interventions", [])),
+            "cells_given_up": report.get("cells_given_up", 0),
+        }
     return point | {figure: figures.get(figure) for figure in FIGURES}
 
 

@@ -114,18 +114,10 @@ def _uncovered_in_sight(world: World, lack: np.ndarray, x: float, y: float) -> i
 
 
 def default_patience(world: World) -> float:
-    """model.watchdog's default: twice the time to drive across the reachable space at k_v (its geodesic
-    diameter, by a double sweep), and at least 20 replanning periods."""
+    """model.watchdog's default: twice the time to drive across the reachable space at k_v
+    (:attr:`model.world.world.World.across`), and at least 20 replanning periods."""
     scenario = world.scenario
-    if world.open:
-        across = float(np.hypot(*scenario.domain))
-    else:
-        start = np.argwhere(world.reachable)[0]
-        first = world._field(int(start[0]), int(start[1]))
-        far = np.unravel_index(int(np.argmax(np.where(np.isfinite(first) & world.reachable, first, -1.0))), first.shape)
-        second = world._field(int(far[0]), int(far[1]))
-        across = float(np.max(np.where(np.isfinite(second) & world.reachable, second, 0.0)))
-    return max(2.0 * across / scenario.k_v, 20.0 * scenario.replan_period)
+    return max(2.0 * world.across / scenario.k_v, 20.0 * scenario.replan_period)
 
 
 @dataclass

@@ -148,3 +148,22 @@ def test_another_cell_refits_the_map_with_its_own_domain_and_corner(tmp_path):
     assert coarser.grid_shape == (fitted.occupied.shape[0] // 4, fitted.occupied.shape[1] // 4)
     with pytest.raises(ScenarioError, match=r"'domain': the map .* spans"):
         scenario.with_overrides(cell=0.2, domain=list(scenario.domain))
+
+
+def test_initial_poses_and_objectives_are_read_in_the_maps_frame(tmp_path):
+    """A user gives poses as RViz shows them: in the map's frame. The room of saved_map spans x -6.5 .. -0.45
+    and y -2.7 .. 1.35 there; a robot started at (-3, -0.5) heading north and sent to (-1.5, 0.5) starts and
+    ends there in trajectory.csv, and a pose given in the model's own frame (0 .. 6.6) is refused, by key."""
+    scenario_on_saved_map(tmp_path)
+    text = (tmp_path / "s.toml").read_text().replace("max_time = 6000.0", "max_time = 40.0")
+    (tmp_path / "s.toml").write_text(text + "initial_poses = [[-3.0, -0.5, 90.0]]\nobjectives = [[-1.5, 0.5]]\n")
+    scenario = load_scenario(tmp_path / "s.toml")
+    write_run_directory(run_scenario(scenario), tmp_path / "out")
+    with open(tmp_path / "out" / "trajectory.csv") as source:
+        rows = list(csv.DictReader(source))
+    assert (float(rows[0]["x"]), float(rows[0]["y"])) == pytest.approx((-3.0, -0.5))
+    gaps = [np.hypot(float(row["x"]) + 1.5, float(row["y"]) - 0.5) for row in rows]
+    assert gaps[0] > 1.5 and min(gaps) <= scenario.range / 2 + 0.05  # eq. 10 stops it R/2 short
+    (tmp_path / "s.toml").write_text(text + "initial_poses = [[3.0, 2.0, 90.0]]\n")
+    with pytest.raises(ScenarioError, match=r"'initial_poses': entry 0 \[3.0, 2.0\] lies outside the domain \(in the map's frame\) \[-6\.6"):
+        load_scenario(tmp_path / "s.toml")

@@ -8,8 +8,9 @@ import pytest
 from anicov.engine import run_scenario
 from anicov.radio_engine import run_ranged
 from model.parameters import coverage_map_of, starting_poses
-from model.scenario import ScenarioError
+from model.scenario import ScenarioError, validate
 from runtime.rundir import summary_of
+from tests.test_watchdog import stalling_values
 
 
 @pytest.fixture
@@ -78,3 +79,28 @@ def test_bad_radio_keys_name_the_key(small, overrides, message):
 def test_comm_range_inf_is_the_default(small):
     assert small.comm_range == math.inf and small.with_overrides(comm_range=math.inf) == small
     assert np.isinf(small.with_overrides(comm_range=float("inf")).comm_range)
+
+
+def crawling_values(**extra):
+    """Two robots that barely move (k_v = 1e-4) in tests/test_watchdog.py's open square: they cover what they
+    see from their starts and then nothing, so the watchdog sets cells aside and gives them up until none is
+    left (every run ends at t = 1800 of max_time 2000; measured)."""
+    values = stalling_values(agents=2, initial_poses=[[2.0, 2.0, 0.0], [3.0, 2.0, 90.0]], k_v=1e-4, **extra)
+    values.pop("objectives")
+    return values
+
+
+@pytest.mark.parametrize("planning", ["central", "local"])
+def test_the_watchdog_ends_a_stalled_run_on_a_radio_as_in_the_engine(planning):
+    """On a radio of limited range the central planner's watchdog, or each robot's own (planning locally),
+    gives up the cells left and the run ends there, when the engine's does."""
+    result = run_scenario(validate(crawling_values(comm_range=8.0, planning=planning)))
+    engine = run_scenario(validate(crawling_values()))
+    assert not result.completed and result.steps == engine.steps < engine.scenario.max_steps
+    left = result.final_lack > 0.0
+    assert left.any() and not (left & ~result.given_up).any()
+    times = [(stall.time, stall.action) for stall in engine.stalls]
+    if planning == "central":
+        assert [(stall.time, stall.action) for stall in result.stalls] == times
+    else:  # each robot's watchdog, both in touch: the same stalls, once per robot
+        assert [(stall.time, stall.action) for stall in result.stalls] == [t for t in times for _ in range(2)]

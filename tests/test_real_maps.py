@@ -7,6 +7,7 @@ machine cannot (no apt), these tests are skipped with that reason, except under 
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import re
 
@@ -15,8 +16,11 @@ import pytest
 from anicov.engine import run_scenario
 from model.scenario import load_scenario
 from model.world.world import fitted_map_of, map_corner_of, world_of
+from runtime.lifecycle import EXIT_INCOMPLETE
 from runtime.rundir import summary_of
 from tests.conftest import ROOT
+from tests.teamrun import anicov, launcher_command, processes_of, run, unique_team
+from tests.test_team import assert_same_run
 
 REAL = ROOT / "scenarios" / "real"
 SCENARIOS = sorted(REAL.glob("*.toml"))
@@ -85,3 +89,23 @@ def test_a_team_of_eight_completes_the_campus_map_with_the_watchdog_s_one_interv
     assert report["deadlocks_resolved"] <= report["deadlocks"]
     assert report["min_separation"] >= 2 * scenario.robot_radius + scenario.safety_margin - 0.01
     assert report["min_clearance"] >= scenario.robot_radius
+
+
+def test_lockstep_over_zenoh_equals_the_engine_byte_for_byte_on_the_lab_map(tmp_path):
+    """The team as processes on a map robots made, at Burger units (N = 2, seed 1, the first 150 time units:
+    1,500 steps with robots among the lab's pillars, the filter and the crowding rule at work): trajectory.csv
+    (in the map's frame) and summary.json are the engine's, byte for byte."""
+    scenario_path = REAL / "uwb-lab.toml"
+    map_path = map_of(scenario_path)
+    text = re.sub(r'^map = "[^"]+"', f'map = "{map_path}"', scenario_path.read_text(), flags=re.MULTILINE)
+    text = re.sub(r"^max_time = .*$", "max_time = 150.0", text, flags=re.MULTILINE)
+    config = tmp_path / "lab.toml"
+    config.write_text(text.replace("agents = 4", "agents = 2").replace("seed = 0", "seed = 1"))
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+    assert engine.returncode == EXIT_INCOMPLETE, engine.stderr  # max_time: 150 of the 2311 it needs
+    team = unique_team()
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record", team=team))
+    assert launched.returncode == EXIT_INCOMPLETE, launched.stderr + launched.stdout
+    assert_same_run(tmp_path / "engine", tmp_path / "team")
+    assert json.loads((tmp_path / "team" / "summary.json").read_text())["terrain"]["map_corner"] == pytest.approx([-3.4, -9.6])
+    assert processes_of(team) == []

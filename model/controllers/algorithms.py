@@ -17,7 +17,7 @@ from model.planning import TeamPlanner, path_lengths
 from model.scenario import Scenario
 from model.world.crowding import spread_shared, team_spacing
 from model.world.reachability import viewpoints
-from model.world.world import viewing_range_of, world_of
+from model.world.world import map_corner_of, viewing_range_of, world_of
 
 
 @dataclass
@@ -36,9 +36,10 @@ class Planner(TeamPlanner):
         objective is taken at the centre of the blob's cell it was found in, then moved to where a robot can see it from (:func:`model.world.reachability.viewpoints`)
         and Algorithm 2 takes the lengths of the shortest free paths to them (:func:`path_lengths`); robots with
         bodies that share an objective each get a place of their own (:mod:`model.world.crowding`)."""
-        if self.scenario.objectives:
+        if self.scenario.objectives:  # in the map's frame, with a map (model.scenario.safety_keys)
             ids = range(len(positions)) if members is None else members
-            return np.array([self.scenario.objectives[agent] for agent in ids], dtype=np.float64).reshape(-1, 2)
+            fixed = np.array([self.scenario.objectives[agent] for agent in ids], dtype=np.float64).reshape(-1, 2)
+            return fixed - np.array(map_corner_of(self.scenario))
         world = world_of(self.scenario)
         terrain = bool(world.ground.walls)
         self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range, by_paths=terrain)

@@ -13,12 +13,18 @@
   seed's draw.
 - ``objectives = [[x, y], ...]``: fixed objectives, one per robot, instead of Algorithms 1–2 (a
   mission to given points; the deadlock cases of the tests use it).
+
+With a ``map`` both are in the map's own frame (what RViz shows; :mod:`model.scenario.map_fit`), as
+trajectory.csv is: the model subtracts the fitted map's corner (:func:`model.world.world.map_corner_of`).
 """
 
 from __future__ import annotations
 
 import math
 from typing import Any
+
+from model.scenario.map_file import load_map
+from model.scenario.map_fit import fit_to_cells
 
 SAFETY_DEFAULTS: dict[str, Any] = {
     "safety": True,
@@ -88,6 +94,11 @@ def least_safety_range(
 
 def check_safety(scenario: Any) -> None:
     """The checks that need the whole scenario (agents, domain, gains); raises SafetyKeyError."""
+    corner = (0.0, 0.0)
+    if scenario.map and (scenario.initial_poses or scenario.objectives):
+        corner = fit_to_cells(load_map(scenario.map), scenario.cell).corner  # the poses are in the map's frame
+    low_x, low_y = corner
+    high_x, high_y = corner[0] + scenario.domain[0], corner[1] + scenario.domain[1]
     for key in ("initial_poses", "objectives"):
         points = getattr(scenario, key)
         if points and len(points) != scenario.agents:
@@ -95,10 +106,11 @@ def check_safety(scenario: Any) -> None:
                 f"scenario key '{key}': expected {scenario.agents} entries (one per robot), got {len(points)}"
             )
         for index, point in enumerate(points):
-            if not (0.0 <= point[0] <= scenario.domain[0] and 0.0 <= point[1] <= scenario.domain[1]):
+            if not (low_x <= point[0] <= high_x and low_y <= point[1] <= high_y):
+                frame = " (in the map's frame)" if scenario.map else ""
                 raise SafetyKeyError(
-                    f"scenario key '{key}': entry {index} {list(point[:2])} lies outside the domain "
-                    f"[0, {scenario.domain[0]}] x [0, {scenario.domain[1]}]"
+                    f"scenario key '{key}': entry {index} {list(point[:2])} lies outside the domain{frame} "
+                    f"[{low_x:g}, {high_x:g}] x [{low_y:g}, {high_y:g}]"
                 )
     if not scenario.filters:
         return

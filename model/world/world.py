@@ -108,6 +108,19 @@ class World:
         return field
 
     @functools.cached_property
+    def across(self) -> float:
+        """How far a robot may have to drive to cross its reachable space: the domain's diagonal in the open
+        world, else the geodesic diameter of the reachable cells (a double sweep: the farthest cell from the
+        first reachable one, then the farthest from that)."""
+        if self.open:
+            return float(np.hypot(*self.scenario.domain))
+        start = np.argwhere(self.reachable)[0]
+        first = self._field(int(start[0]), int(start[1]))
+        far = np.unravel_index(int(np.argmax(np.where(np.isfinite(first) & self.reachable, first, -1.0))), first.shape)
+        second = self._field(int(far[0]), int(far[1]))
+        return float(np.max(np.where(np.isfinite(second) & self.reachable, second, 0.0)))
+
+    @functools.cached_property
     def _graph(self) -> csr_matrix:
         return grid_graph(self.passable, self.scenario.cell).tocsr()
 
