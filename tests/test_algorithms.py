@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from model.controllers.algorithms import Planner
+from model.controllers.algorithms import Planner, blob_targets
+from model.paper.objectives import BlobObjectives
 from model.scenario import Scenario
 
 SCENARIO = Scenario(domain=(60.0, 60.0), agents=3)
@@ -32,3 +33,20 @@ def test_a_fully_covered_map_sends_everyone_nowhere():
     planner = Planner(SCENARIO)
     positions = np.array([[5.0, 5.0], [55.0, 5.0], [30.0, 55.0]])
     assert np.array_equal(planner.plan(np.zeros(SCENARIO.grid_shape), positions), positions)
+
+
+def test_a_blob_is_seen_for_an_uncovered_cell_of_its_own():
+    """blob_targets: the cell Algorithm 1 found the objective in while it is uncovered; covered, the cell its
+    point falls in (a centroid on a cell's edge falls in the next cell: lines 1-5 keep the objective for
+    that one); both covered, the blob's uncovered cell nearest the point (the first in row order on a tie)."""
+    lack = np.zeros((10, 10))
+    labels = np.zeros((10, 10), dtype=np.int32)
+    labels[4:8, 5] = 1  # a blob of four cells in a column
+    lack[4:8, 5] = 1.0
+    point = np.array([5.5, 6.0])  # on the edge between rows 5 and 6 (cell 1.0): it falls in row 6
+    blobs = BlobObjectives(positions=point[None, :], labels=labels, cells=np.array([[5, 5]]))
+    assert blob_targets(blobs, lack, 1.0).tolist() == [[5.5, 5.5]]
+    lack[5, 5] = 0.0
+    assert blob_targets(blobs, lack, 1.0).tolist() == [[5.5, 6.5]]
+    lack[6, 5] = 0.0
+    assert blob_targets(blobs, lack, 1.0).tolist() == [[5.5, 4.5]]  # rows 4 and 7 left, as near: the first

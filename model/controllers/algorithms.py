@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from model.paper.assignment import assign_objectives
-from model.paper.objectives import BlobObjectives, fallback_objective, select_objectives
+from model.paper.objectives import BlobObjectives, cell_of, fallback_objective, select_objectives
 from model.planning import TeamPlanner, path_lengths
 from model.scenario import Scenario
 from model.world.crowding import spread_shared, team_spacing
@@ -52,7 +52,7 @@ class Planner(TeamPlanner):
         if not terrain:
             return objectives[assign_objectives(positions, objectives)]
         if len(self.blobs.positions) and self.blobs.cells is not None:
-            objectives = (self.blobs.cells[:, ::-1] + 0.5) * self.scenario.cell  # each blob's own cell (BlobObjectives.cells)
+            objectives = blob_targets(self.blobs, lack, self.scenario.cell)
         places = viewpoints(
             world.occupied, world.reachable, objectives, viewing_range_of(self.scenario), self.scenario.cell
         )
@@ -61,3 +61,25 @@ class Planner(TeamPlanner):
         if (spacing := team_spacing(self.scenario)) > 0.0:
             return spread_shared(world, objectives, places, choice, lengths, positions, spacing)
         return places[choice]
+
+
+def blob_targets(blobs: BlobObjectives, lack: np.ndarray, cell: float) -> np.ndarray:
+    """(M, 2): the centre of an uncovered cell of each objective's blob, for its viewpoint: the cell Algorithm 1
+    found the objective in (:attr:`BlobObjectives.cells`) while it is uncovered, else the cell its point falls
+    in (what lines 1-5 keep the objective for), else the blob's uncovered cell nearest the point (the first in
+    row order on a tie). An objective
+    kept for the cell its point falls in, its own cell covered, sent a lone robot on the campus map to a
+    viewpoint of that covered cell, from which the blob's last two cells could not be seen (seed 15)."""
+    assert blobs.cells is not None
+    rows, cols = lack.shape
+    targets = np.zeros((blobs.count, 2))
+    for j, ((row, col), point) in enumerate(zip(blobs.cells, blobs.positions, strict=True)):
+        if lack[row, col] <= 0.0:
+            row, col = cell_of(point, cell, lack.shape)
+        if lack[row, col] <= 0.0 and blobs.labels is not None:
+            left = np.argwhere((blobs.labels == j + 1) & (lack > 0.0))
+            if len(left):
+                gaps = np.hypot((left[:, 1] + 0.5) * cell - point[0], (left[:, 0] + 0.5) * cell - point[1])
+                row, col = left[int(np.argmin(gaps))]
+        targets[j] = (min(max(col, 0), cols - 1) + 0.5) * cell, (min(max(row, 0), rows - 1) + 0.5) * cell
+    return targets
