@@ -6,20 +6,24 @@ machine cannot (no apt), these tests are skipped with that reason, except under 
 
 from __future__ import annotations
 
+import csv
 import hashlib
 import json
 import os
 import re
+from pathlib import Path
 
+import numpy as np
 import pytest
 
 from anicov.engine import run_scenario
+from model.parameters import starting_poses
 from model.scenario import load_scenario
 from model.world.world import fitted_map_of, map_corner_of, world_of
 from runtime.lifecycle import EXIT_INCOMPLETE
 from runtime.rundir import summary_of
 from tests.conftest import ROOT
-from tests.teamrun import anicov, launcher_command, processes_of, run, unique_team
+from tests.teamrun import anicov, check_realtime_run, launcher_command, processes_of, run, unique_team
 from tests.test_team import assert_same_run
 
 REAL = ROOT / "scenarios" / "real"
@@ -94,17 +98,79 @@ def test_lockstep_over_zenoh_equals_the_engine_byte_for_byte_on_the_lab_map(tmp_
     """The team as processes on a map robots made, at Burger units (N = 2, seed 1, the first 150 time units:
     1,500 steps with robots among the lab's pillars, the filter and the crowding rule at work): trajectory.csv
     (in the map's frame) and summary.json are the engine's, byte for byte."""
-    scenario_path = REAL / "uwb-lab.toml"
-    map_path = map_of(scenario_path)
-    text = re.sub(r'^map = "[^"]+"', f'map = "{map_path}"', scenario_path.read_text(), flags=re.MULTILINE)
-    text = re.sub(r"^max_time = .*$", "max_time = 150.0", text, flags=re.MULTILINE)
-    config = tmp_path / "lab.toml"
-    config.write_text(text.replace("agents = 4", "agents = 2").replace("seed = 0", "seed = 1"))
+    config = lab_config(tmp_path, agents=2, seed=1, max_time=150.0)
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
-    assert engine.returncode == EXIT_INCOMPLETE, engine.stderr  # max_time: 150 of the 2311 it needs
+    assert engine.returncode == EXIT_INCOMPLETE, engine.stderr  # max_time: 150 of the 1912.5 it needs
     team = unique_team()
     launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record", team=team))
     assert launched.returncode == EXIT_INCOMPLETE, launched.stderr + launched.stdout
     assert_same_run(tmp_path / "engine", tmp_path / "team")
-    assert json.loads((tmp_path / "team" / "summary.json").read_text())["terrain"]["map_corner"] == pytest.approx([-3.4, -9.6])
+    assert json.loads((tmp_path / "team" / "summary.json").read_text())["terrain"]["map_corner"] == pytest.approx(
+        [-3.4, -9.6]
+    )
+    assert processes_of(team) == []
+
+
+def lab_config(tmp_path, agents: int, seed: int, max_time: float) -> Path:
+    """The lab scenario with its map named by absolute path, for a team launched from anywhere."""
+    scenario_path = REAL / "uwb-lab.toml"
+    map_path = map_of(scenario_path)
+    text = re.sub(r'^map = "[^"]+"', f'map = "{map_path}"', scenario_path.read_text(), flags=re.MULTILINE)
+    text = re.sub(r"^max_time = .*$", f"max_time = {max_time}", text, flags=re.MULTILINE)
+    config = tmp_path / "lab.toml"
+    config.write_text(text.replace("agents = 4", f"agents = {agents}").replace("seed = 0", f"seed = {seed}"))
+    return config
+
+
+def test_the_team_completes_the_lab_map_in_realtime(tmp_path):
+    """launch_team.py --clock realtime on a map robots made: N = 4, seed 1 (in process: complete at 986 time
+    units; realtime here 994, a minute), at 20 time units a wall second; complete, every robot's rows dt apart,
+    commands within the paper's bounds, each robot's path as its commands ask (tests/teamrun.check_realtime_run).
+    (Eight robots at that speed on two cores stand still: the filter stops a robot whose teammate's pose is
+    older than max_pose_age, 0.5 time units, 25 ms of wall time at speed 20.)"""
+    config = lab_config(tmp_path, agents=4, seed=1, max_time=20000.0)
+    team = unique_team()
+    command = launcher_command(
+        "--config", str(config), "--clock", "realtime", "--speed", "20", "--out", str(tmp_path / "team"), team=team
+    )
+    launched = run(command, timeout=600)
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    scenario = load_scenario(config)
+    summary = check_realtime_run(tmp_path / "team", scenario.k_v, scenario.k_omega, scenario.dt, simulated=True)
+    assert summary["min_clearance"] >= scenario.robot_radius and summary["terrain"]["map_corner"] == pytest.approx(
+        [-3.4, -9.6]
+    )
+    assert (tmp_path / "team" / "recording.rrd").stat().st_size > 0
+    assert processes_of(team) == []
+
+
+def test_ros2_bases_drive_the_lab_map_at_a_burger_s_real_units(tmp_path):
+    """The ROS 2 team (stand-in bases: deploy/ros2/test_base.py, odometry at 30 Hz) on the lab map at the map's
+    own units, metres and seconds (a Burger's 0.22 m/s, 10 Hz control): 20 s of driving, then max_time. The
+    bases' odometry, in the map's frame, stays in the lab's free space, off the walls by r, each base at the
+    start pose the scenario draws, and the team covers some of the lab."""
+    config = lab_config(tmp_path, agents=2, seed=1, max_time=20.0)
+    team = unique_team()
+    command = launcher_command(
+        "--config", str(config), "--robot", "ros2", "--test-bases", "--clock", "realtime", "--out", str(tmp_path / "team"),
+        team=team,
+    )  # fmt: skip
+    launched = run(command, timeout=300)
+    assert launched.returncode == EXIT_INCOMPLETE, launched.stderr + launched.stdout
+    scenario = load_scenario(config)
+    summary = json.loads((tmp_path / "team" / "summary.json").read_text())
+    assert summary["min_clearance"] >= scenario.robot_radius and summary["final_error"] < 0.99
+    with open(tmp_path / "team" / "trajectory.csv") as source:
+        rows = list(csv.DictReader(source))
+    corner = map_corner_of(scenario)
+    starts = starting_poses(scenario)
+    world = world_of(scenario)
+    for agent in range(2):
+        mine = [row for row in rows if int(row["agent"]) == agent]
+        xs, ys = np.array([float(r["x"]) for r in mine]), np.array([float(r["y"]) for r in mine])
+        assert (xs[0] - corner[0], ys[0] - corner[1]) == pytest.approx(tuple(starts[agent, :2]), abs=0.02)
+        assert np.hypot(np.diff(xs), np.diff(ys)).sum() > 1.0  # it drove
+        cols = ((xs - corner[0]) / scenario.cell).astype(int)
+        rows_ = ((ys - corner[1]) / scenario.cell).astype(int)
+        assert not world.occupied[rows_, cols].any()
     assert processes_of(team) == []

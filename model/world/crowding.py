@@ -8,7 +8,7 @@ barrier at its back and a wall ahead, the others held behind it, for good.
 
 So on a terrain with bodies (:func:`team_spacing` > 0), of the robots that share an objective the one with
 the shortest free path goes to its viewpoint (:func:`model.world.reachability.viewpoints`), and each of the
-others to the nearest other reachable cell that sees the same target (:func:`model.world.reachability.seers`)
+others to the reachable cell nearest itself that sees the same target (:func:`model.world.reachability.seers`)
 at least the spacing from every place already given; a robot for which no such cell is left stays clear of
 them: where it is, or the nearest reachable cell that is far enough from all of them.
 """
@@ -71,12 +71,17 @@ def _clear_of(point: np.ndarray, taken: list[np.ndarray], spacing: float) -> boo
 def _own_place(
     world: World, target: np.ndarray, position: np.ndarray, taken: list[np.ndarray], spacing: float
 ) -> np.ndarray:
-    """The nearest reachable cell that sees ``target`` and is clear of every place taken; with none left,
-    the robot's own position if it is clear of them, else the nearest reachable cell centre that is."""
+    """The reachable cell nearest the robot that sees ``target`` and is clear of every place taken; with none
+    left, the robot's own position if it is clear of them, else the nearest reachable cell centre that is.
+    Nearest the robot, not the target: a helper sent to the seer nearest the blob drove round to the far
+    side of the teammate at the blob's viewpoint, in a passage, and the two held each other for good, one
+    unable to pass, the other looking at the cell through the first one's body (the campus map, N = 4 seed 12)."""
     cell, sensing_range = world.scenario.cell, viewing_range_of(world.scenario)
     row, col = math.floor(target[1] / cell), math.floor(target[0] / cell)
     centre_x, centre_y = (col + 0.5) * cell, (row + 0.5) * cell  # what coverable means (viewpoints does the same)
-    for _, x, y in seers(world.occupied, world.reachable, centre_x, centre_y, sensing_range, cell):
+    found = seers(world.occupied, world.reachable, centre_x, centre_y, sensing_range, cell)
+    order = np.argsort(np.hypot(found[:, 1] - position[0], found[:, 2] - position[1]), kind="stable")
+    for _, x, y in found[order]:
         if _clear_of(np.array((x, y)), taken, spacing):
             return np.array((x, y))
     if _clear_of(position, taken, spacing):
