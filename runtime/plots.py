@@ -13,7 +13,7 @@ from matplotlib.patches import Circle
 
 from model.run import RunResult
 from model.scenario import Scenario
-from model.world.world import world_of
+from model.world.world import map_corner_of, world_of
 
 
 def plot_domain_error(result: RunResult, path: Path) -> None:
@@ -52,52 +52,52 @@ def plot_velocities(result: RunResult, path: Path) -> None:
 
 
 def plot_coverage_maps(result: RunResult, path: Path) -> None:
-    """Fig. 6: lack of coverage Υ at four times, with the trajectories so far (and the walls, on a terrain)."""
+    """Fig. 6: lack of coverage Υ at four times, with the trajectories so far (and the walls, on a terrain).
+    With a map, in the map's own frame (as trajectory.csv: the model's plus the fitted map's corner)."""
     scenario = result.scenario
     width, height = scenario.domain
+    x0, y0 = map_corner_of(scenario)
+    box = (x0, x0 + width, y0, y0 + height)
     last = len(result.snapshots) - 1
     picks = sorted({round(last * fraction) for fraction in (0.25, 0.5, 0.75, 1.0)})
     fig, axes = plt.subplots(1, len(picks), figsize=(3.3 * len(picks), 3.6), squeeze=False)
     for ax, pick in zip(axes[0], picks, strict=True):
         time = result.snapshot_times[pick]
-        ax.imshow(
-            result.snapshots[pick] / 255.0,
-            origin="lower",
-            extent=(0, width, 0, height),
-            cmap="gray_r",
-            vmin=0.0,
-            vmax=1.0,
-        )
-        draw_obstacles(ax, scenario)
+        ax.imshow(result.snapshots[pick] / 255.0, origin="lower", extent=box, cmap="gray_r", vmin=0.0, vmax=1.0)
+        draw_obstacles(ax, scenario, box)
         upto = min(round(time / scenario.dt) + 1, len(result.trace))
         for agent in range(scenario.agents):
-            (line,) = ax.plot(result.trace[:upto, agent, 0], result.trace[:upto, agent, 1], linewidth=0.6)
-            x, y = result.trace[upto - 1, agent, 0], result.trace[upto - 1, agent, 1]
+            xs, ys = result.trace[:upto, agent, 0] + x0, result.trace[:upto, agent, 1] + y0
+            (line,) = ax.plot(xs, ys, linewidth=0.6)
             if scenario.robot_radius > 0.0:  # the robot's disk, to scale (issue 12)
-                ax.add_patch(Circle((x, y), scenario.robot_radius, fill=False, color=line.get_color(), linewidth=0.8))
+                ax.add_patch(
+                    Circle((xs[-1], ys[-1]), scenario.robot_radius, fill=False, color=line.get_color(), linewidth=0.8)
+                )
             else:
-                ax.plot(x, y, "o", markersize=5, mfc="none", color=line.get_color())
-        ax.plot([0, width, width, 0, 0], [0, 0, height, height, 0], "k--", linewidth=0.8)
-        ax.set_xlim(-0.1 * width, 1.1 * width)
-        ax.set_ylim(-0.1 * height, 1.1 * height)
+                ax.plot(xs[-1], ys[-1], "o", markersize=5, mfc="none", color=line.get_color())
+        ax.plot([box[0], box[1], box[1], box[0], box[0]], [box[2], box[2], box[3], box[3], box[2]], "k--", linewidth=0.8)
+        ax.set_xlim(x0 - 0.1 * width, x0 + 1.1 * width)
+        ax.set_ylim(y0 - 0.1 * height, y0 + 1.1 * height)
         ax.set_aspect("equal")
         ax.set_title(f"t = {time:.0f}")
+        if scenario.map:
+            ax.set_xlabel("x, map frame")
     fig.suptitle("Lack of coverage Υ (black: uncovered) and trajectories (Fig. 6)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
-def draw_obstacles(ax: plt.Axes, scenario: Scenario) -> None:
-    """Occupied cells in brown, and free cells nobody can see hatched (nothing, in the open world)."""
+def draw_obstacles(ax: plt.Axes, scenario: Scenario, box: tuple[float, float, float, float]) -> None:
+    """Occupied cells in brown, and free cells nobody can see hatched (nothing, in the open world), over
+    ``box`` (left, right, bottom, top)."""
     world = world_of(scenario)
     if world.open:
         return
-    width, height = scenario.domain
     layers = np.zeros((*world.occupied.shape, 4))
     layers[world.occupied] = (0.45, 0.27, 0.1, 1.0)
     layers[~world.occupied & ~world.coverable] = (0.2, 0.4, 0.9, 0.55)
-    ax.imshow(layers, origin="lower", extent=(0, width, 0, height), interpolation="nearest")
+    ax.imshow(layers, origin="lower", extent=box, interpolation="nearest")
 
 
 def write_run_plots(result: RunResult, out_dir: Path) -> list[Path]:
