@@ -50,11 +50,17 @@ def spread_shared(
     """The place (x, y) of every robot, (N, 2). ``targets`` (M, 2): Algorithm 1's objectives (what to see);
     ``places`` (M, 2): their viewpoints; ``choice`` (N,): Algorithm 2's objective of each robot; ``lengths``
     (N, M): the free paths' lengths from each robot to each viewpoint. An objective's first robot (shortest
-    path, then lowest id) gets its viewpoint; then the others, in the same order, their own places."""
+    path, then lowest id) gets its viewpoint, unless an objective before it has that place (two blobs may
+    share their nearest seer: two robots on the lab map were sent to one spot, N = 8 seed 20); then the
+    others, in the same order, their own places."""
     goals = places[choice].copy()
     order = sorted(range(len(choice)), key=lambda i: (lengths[i, choice[i]], i))
     first = {int(choice[i]): i for i in reversed(order)}
-    taken = [places[j] for j in sorted(first)]
+    taken: list[np.ndarray] = []
+    for j in sorted(first):
+        if not _clear_of(places[j], taken, spacing):
+            goals[first[j]] = _own_place(world, targets[j], positions[first[j]], taken, spacing)
+        taken.append(goals[first[j]])
     for i in order:
         j = int(choice[i])
         if first[j] == i:
