@@ -178,7 +178,7 @@ class AgentNode:
 
     def ends_on_its_own(self) -> bool:
         """Realtime, local planning: end the run here when RadioLink.ends_now says so."""
-        if self.finished is None and self.radio.ends_now(self.replica.map):
+        if self.finished is None and self.radio.ends_now(self.replica.map, self.options.no_coordinator):
             log.info(
                 "agent %d: its replica is complete (or all it has left was given up by its watchdog) and no "
                 "coordinator ended the run: it ends",

@@ -78,12 +78,14 @@ class RadioLink:
         mine = targets[members.index(self.me)]
         return float(mine[0]), float(mine[1])
 
-    def ends_now(self, replica: CoverageMap) -> bool:
-        """Local planning: our ``replica`` is complete (so the world is), or our watchdog gave up every cell it
-        has left, and has been for LOCAL_END_WAIT seconds without the coordinator ending the run (it is gone)."""
+    def ends_now(self, replica: CoverageMap, alone: bool) -> bool:
+        """Local planning: our ``replica`` is complete (so the world is), or, in a team with no coordinator
+        (``alone``), our watchdog gave up every cell it has left, and has been for LOCAL_END_WAIT seconds
+        without the coordinator ending the run (it is gone). With a coordinator, its watchdog ends the run:
+        ours may give up a cell a teammate's or the coordinator's does not."""
         if self.planner is None:
             return False
-        given_up = self.planner.given_up()
+        given_up = self.planner.given_up() if alone else None
         if not replica.complete and (
             given_up is None or not given_up.any() or not self.planner.only_given_up_left(replica.lack_of_coverage())
         ):

@@ -217,11 +217,11 @@ def only_given_up_left(
 def watchdog_outcome(
     scenario: Scenario, central: WatchedPlanner, planners: list[WatchedPlanner]
 ) -> tuple[list[Stall], np.ndarray | None]:
-    """(stalls, cells given up): central, its watchdog's; local, every robot's, in time order, and the
-    cells any of them gave up."""
+    """(stalls, cells given up): central, its watchdog's; local, every robot's, in time order, a stall that
+    several robots' watchdogs saw alike (robots in touch plan alike) once, and the cells any of them gave up."""
     if scenario.planning == "central":
         return list(central.stalls), central.given_up()
-    stalls = sorted((stall for planner in planners for stall in planner.stalls), key=lambda stall: stall.time)
+    stalls = sorted({stall: None for planner in planners for stall in planner.stalls}, key=lambda stall: stall.time)
     given = [planner.given_up() for planner in planners if planner.given_up() is not None]
     return stalls, (np.logical_or.reduce(given) if given else None)
 

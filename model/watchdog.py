@@ -1,4 +1,4 @@
-"""The progress watchdog (issue 34): a run in which e_D stops falling is noticed, explained and acted on.
+"""The progress watchdog (issue 34): a run that stops covering cells is noticed, explained and acted on.
 
 It runs inside the team's planning (:meth:`model.planning.TeamPlanner.plan_watched`), so the in-process engine
 and the coordinator process, which plan at the same steps from the same map, see the same stalls and do the

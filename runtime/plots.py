@@ -75,7 +75,9 @@ def plot_coverage_maps(result: RunResult, path: Path) -> None:
                 )
             else:
                 ax.plot(xs[-1], ys[-1], "o", markersize=5, mfc="none", color=line.get_color())
-        ax.plot([box[0], box[1], box[1], box[0], box[0]], [box[2], box[2], box[3], box[3], box[2]], "k--", linewidth=0.8)
+        ax.plot(
+            [box[0], box[1], box[1], box[0], box[0]], [box[2], box[2], box[3], box[3], box[2]], "k--", linewidth=0.8
+        )
         ax.set_xlim(x0 - 0.1 * width, x0 + 1.1 * width)
         ax.set_ylim(y0 - 0.1 * height, y0 + 1.1 * height)
         ax.set_aspect("equal")

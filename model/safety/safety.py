@@ -98,7 +98,7 @@ def filter_command(
         v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
     )
     if stale:  # it depends on the poses alone, not on the command
-        memory[HELD] = 0
+        memory[HELD] = memory[TURNING] = memory[TURNING_OUT] = 0
         return 0.0, 0.0, STALE_NEIGHBOUR
     law_omega = omega_hat  # what FILTER_CHANGED compares with, also when the slide turns the nominal
     pressed = wall_x != 0.0 or wall_y != 0.0
@@ -166,7 +166,7 @@ def _deadlock(
         memory[YIELDING] = 1
         v, omega, feasible = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
         return v, omega, feasible, flags | KEEPING_RIGHT
-    if turning:
+    if _in_place(v_hat, omega_hat, safety):
         v_other, omega_other, feasible_other, turns = _long_way(
             v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, memory
         )
@@ -205,10 +205,10 @@ def _other_way(
     it cannot: its drive away is held too (a wall), or no teammate's constraint binds its own command (no
     deadlock would ever be found). The other starts at a deadlock (:func:`filter_command`). The turn is
     kept (``memory``) until the law itself turns that way (past the far side) or stops turning in place,
-    or the long way is held too. A deadlock's way out that ends so, not held, is a deadlock resolved."""
+    or the long way is held too. A deadlock's way out that ends so (not by the long way held) is a deadlock
+    resolved."""
     ahead = safety.lookahead
-    in_place = abs(v_hat) < ahead * abs(omega_hat) and ahead * abs(omega_hat) > WANTS_TO_MOVE * safety.v_max
-    if not in_place or omega_hat * memory[TURNING] > 0.0:
+    if not _in_place(v_hat, omega_hat, safety) or omega_hat * memory[TURNING] > 0.0:
         flags = DEADLOCK_RESOLVED if memory[TURNING] != 0 and memory[TURNING_OUT] == 1 else 0
         memory[TURNING] = memory[TURNING_OUT] = 0
         return v, omega, feasible, omega_hat, flags
@@ -227,6 +227,14 @@ def _other_way(
     if turns:
         return v_other, omega_other, feasible_other, omega_other, 0
     return v, omega, feasible, omega_hat, 0
+
+
+@njit(cache=True)
+def _in_place(v_hat: float, omega_hat: float, safety: SafetyParameters) -> bool:
+    """The law turns the robot in place: its look-ahead point moves mostly by turning, and more than a
+    robot that does not want to move (WANTS_TO_MOVE)."""
+    ahead = safety.lookahead
+    return abs(v_hat) < ahead * abs(omega_hat) and ahead * abs(omega_hat) > WANTS_TO_MOVE * safety.v_max
 
 
 @njit(cache=True)

@@ -47,7 +47,7 @@ class Scenario:
     controller: str = "paper"
     replan_period: float = 5.0
     watchdog: bool = True  # the progress watchdog (model.watchdog): notices, explains and acts on a stall
-    watchdog_time: float = 0.0  # how long e_D may stay flat before it acts; 0: automatic (model.watchdog)
+    watchdog_time: float = 0.0  # how long no cell may be covered before it acts; 0: automatic (model.watchdog)
     weave: bool = True  # anicov: robots weave their heading where that sweeps faster (model.controllers.anicov.weave); false: straight
     stations: bool = True  # anicov: robots stand at stations and turn their camera, hopping between (model.controllers.anicov.stations); false: a spiral
     # Terrain (issue 11); the defaults are the paper's open world and leave every run as it was.

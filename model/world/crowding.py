@@ -27,9 +27,9 @@ from model.world.world import World, viewing_range_of
 
 def team_spacing(scenario: Scenario) -> float:
     """How far apart the places given to robots that share an objective are: what the safety filter keeps
-    between two robots' look-ahead points (2r + s + 2l) plus a cell, as a robot stops anywhere within
-    half a cell of its place; with the filter off, the bodies (2r) plus a cell. 0 for point robots: the
-    paper's robots share objectives as Algorithm 2 has it."""
+    between two robots' look-ahead points (2r + s + 2l) plus a cell and the planning margin, as a robot
+    stops anywhere within half a cell of its place; with the filter off, the bodies (2r) plus as much. 0 for
+    point robots: the paper's robots share objectives as Algorithm 2 has it."""
     if scenario.robot_radius <= 0.0:
         return 0.0
     clearance = 2.0 * scenario.robot_radius

@@ -72,11 +72,12 @@ def global_law_among_walls(
         # A viewpoint (model.world.reachability.viewpoints: a covered cell from which the blob is seen), or a
         # blob done since the last plan: eq. 10's stop at R/2 frames nothing there (the robot waited R/2 short
         # of it with what it was sent to see nearly out of range). Go to the point itself, and look there.
-        # Arrived within half a cell; one that stopped to look (``look`` set) keeps looking within a whole cell:
-        # at exactly half a cell a robot crept across the line and back, turning to the point and to the
-        # cell in turn, for 200 time units and more, and covered nothing (issue 34, the lab map, N = 1 seed 24).
+        # Arrived within half a cell; one that stopped to look (``look`` set) keeps looking within three quarters
+        # of a cell (less than the gap to any other cell's centre, so a new viewpoint is always driven to): at
+        # exactly half a cell a robot crept across the line and back, turning to the point and to the cell in
+        # turn, for 200 time units and more, and covered nothing (issue 34, the lab map, N = 1 seed 24).
         gap = math.hypot(objective_x - x, objective_y - y)
-        if gap > (cell if look[0] == look[0] else 0.5 * cell):
+        if gap > (0.75 * cell if look[0] == look[0] else 0.5 * cell):
             look[0], look[1] = math.nan, math.nan
             return global_law_around_walls(x, y, objective_x, objective_y, gap, literal_heading)
     elif (detour and distance > cell) or (not detour and u_glo >= 0.0):

@@ -144,9 +144,10 @@ class World:
 def viewing_range_of(scenario: Scenario) -> float:
     """How near a cell must lie to a reachable cell's centre, in clear sight, to count as coverable (and to be
     a viewpoint of it): R less a cell, never under R/2 (eq. 10's stop). A robot sent to a cell stops anywhere
-    within half a cell of its centre, and eq. 2's α falls to 0 at R: on the lab map of issue 34 a cell seen
-    only from 1.4998 of R = 1.5 held a single robot, looking at it, for 15,000 time units. At R less a cell,
-    α ≥ α_max·(cell/2)/R wherever the robot stops (aimed at the cell)."""
+    within half a cell of its centre (and, once looking, stays within three quarters: model.world.wall_law),
+    and eq. 2's α falls to 0 at R: on the lab map of issue 34 a cell seen only from 1.4998 of R = 1.5 held a
+    single robot, looking at it, for 15,000 time units. At R less a cell, α ≥ α_max·(cell/4)/R wherever the
+    robot stands (aimed at the cell)."""
     return max(scenario.range - scenario.cell, 0.5 * scenario.range)
 
 
