@@ -42,8 +42,8 @@ import math
 import numpy as np
 from numba import njit
 
-from model.paper.geometry import wrap_angle
 from model.safety.barrier_constraints import PARKED, TEAMMATE, SafetyParameters, disabled_safety, safe_velocities
+from model.safety.wall_slide import slide_along_wall
 from model.world.ground import Ground
 
 __all__ = ["PARKED", "TEAMMATE", "SafetyParameters", "disabled_safety", "filter_command", "safe_velocities"]
@@ -103,11 +103,11 @@ def filter_command(
     law_omega = omega_hat  # what FILTER_CHANGED compares with, also when the slide turns the nominal
     pressed = wall_x != 0.0 or wall_y != 0.0
     if not binding and pressed and abs(v_hat) > 0.01 * safety.v_max and abs(v) < HELD_FRACTION * abs(v_hat):
-        # Pressed on a wall (the law drives into it and the wall stops it): slide along it (see _slide), in
+        # Pressed on a wall (the law drives into it and the wall stops it): slide along it (model.safety.wall_slide), in
         # the direction the law drives: a robot reversing into a wall turned by the forward slide until it
         # faced away from the wall, its back still on it, and stood there for good (issue 34's lab map).
         travel = poses[me, 2] if v_hat >= 0.0 else poses[me, 2] + math.pi
-        omega_hat = _slide(travel, wall_x, wall_y, safety)
+        omega_hat = slide_along_wall(travel, wall_x, wall_y, safety)
         v, omega, feasible, binding, _, _, _ = safe_velocities(
             v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
         )
@@ -350,27 +350,6 @@ def _drive_along(
         v_hat, omega_hat, me, poses, ages, kinds, ground, cell, safety, 0.0
     )
     return v, omega, feasible
-
-
-SLIDE_AWAY = math.radians(20.0)
-"""How far from the wall's tangent a robot sliding along it heads: at the barrier (h = 0) the filter lets a
-robot move only if it heads away from the wall by more than asin(κ) (9° at the paper's gains)."""
-
-
-@njit(cache=True)
-def _slide(theta: float, wall_x: float, wall_y: float, safety: SafetyParameters) -> float:
-    """An ω that slides a robot pressed on a wall along it (the wall-following rule of bug algorithms):
-    toward the wall's tangent nearest its heading, SLIDE_AWAY off the wall; head-on, to the right. The
-    centre barrier holds v alone, so a robot heading into a wall whose law does not turn it would stand
-    there for ever. From the heading, not the law's wish: that one may point back into the wall."""
-    gain = safety.omega_max / math.pi  # k_ω
-    along = math.cos(theta) * wall_x + math.sin(theta) * wall_y
-    tx, ty = math.cos(theta) - along * wall_x, math.sin(theta) - along * wall_y
-    if math.hypot(tx, ty) < 1e-6:
-        tx, ty = -wall_y, wall_x  # straight at it: to the right (n points back at the robot)
-    side = math.atan2(ty, tx)
-    heading = side + SLIDE_AWAY * math.sin(wrap_angle(math.atan2(wall_y, wall_x) - side))
-    return gain * wrap_angle(heading - theta)
 
 
 @njit(cache=True)
