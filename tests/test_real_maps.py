@@ -122,6 +122,7 @@ def lab_config(tmp_path, agents: int, seed: int, max_time: float) -> Path:
     return config
 
 
+@pytest.mark.slow  # a minute of realtime (30 s for the ROS 2 one): outside the default suite, run with -m slow
 def test_the_team_completes_the_lab_map_in_realtime(tmp_path):
     """launch_team.py --clock realtime on a map robots made: N = 4, seed 1 (in process: complete at 986 time
     units; realtime here 994, a minute), at 20 time units a wall second; complete, every robot's rows dt apart,
@@ -144,6 +145,7 @@ def test_the_team_completes_the_lab_map_in_realtime(tmp_path):
     assert processes_of(team) == []
 
 
+@pytest.mark.slow  # a minute of realtime (30 s for the ROS 2 one): outside the default suite, run with -m slow
 def test_ros2_bases_drive_the_lab_map_at_a_burger_s_real_units(tmp_path):
     """The ROS 2 team (stand-in bases: deploy/ros2/test_base.py, odometry at 30 Hz) on the lab map at the map's
     own units, metres and seconds (a Burger's 0.22 m/s, 10 Hz control): 20 s of driving, then max_time. The
