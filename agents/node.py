@@ -266,7 +266,11 @@ class AgentNode:
             return self.hold_step(self.robot.pose())
         if self.options.clock == "realtime" and self.radio.plan_due(self.step):
             self.plan_locally(self.radio.in_contact(), pose)
-        assert self.objective is not None
+        if self.objective is None:
+            # Realtime, an agent restarted from the coordinator's snapshot whose clock ran before the next
+            # objectives came: it stands still and senses nothing until they do (it crashed here on an
+            # AssertionError, a fresh clone's suite, 2026-12-06). In lockstep the go always follows a plan.
+            return self.hold_step(pose)
         self.positions[me] = pose[:2]
         if self.controller.compiled:
             field = self.world.field(*self.objective) if self.ground.walls else NO_FIELD
@@ -308,8 +312,8 @@ class AgentNode:
         return delta, state
 
     def hold_step(self, pose: Pose) -> tuple[MapDelta, AgentState]:
-        """A step without a current pose (a real base whose odometry stopped): the robot is sent zero and
-        senses nothing, as where it is is not known; the step still counts so the sequence goes on."""
+        """A step without a current pose (a real base whose odometry stopped), or without an objective yet: the
+        robot is sent zero and senses nothing; the step still counts so the sequence goes on."""
         next_pose = self.robot.command(0.0, 0.0)
         delta = MapDelta(self.options.agent, self.step, 0, 0, np.zeros((0, 0), dtype=np.int64))
         self.replica.apply(delta)
