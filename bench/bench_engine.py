@@ -5,7 +5,8 @@ Both run the paper scenario from the same seeded poses and fixed objectives
 the same process, one after the other. Prints Markdown tables: that one; the
 warehouse map with fixed objectives; the kernel inside whole runs on each
 shipped map against the empty domain (issue 11's cost of occlusion); the
-safety filter's cost (issue 12).
+safety filter's cost (issue 12); on the real maps, walls kept to the map's pixel against whole cells
+(issue 34; ``--real-maps`` prints that table alone).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from model.parameters import coverage_map_of, initial_poses, safety_parameters, 
 from model.reference import numpy_team_step
 from model.run import TRACE_FIELDS
 from model.safety.safety import MEMORY_SIZE
-from model.scenario import PAPER_SCENARIO, load_scenario
+from model.scenario import PAPER_SCENARIO, ScenarioError, load_scenario
 from model.world.reachability import nearest_reachable
 from model.world.world import world_of
 
@@ -109,8 +110,12 @@ def numpy_rate(agents: int, steps: int) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--steps", type=int, default=3000, help="engine steps per team size")
+    parser.add_argument("--real-maps", action="store_true", help="only the real maps' wall-detail table")
     args = parser.parse_args()
     print(f"machine: {describe_machine()}")
+    if args.real_maps:
+        wall_detail_table()
+        return
     print("| team N | engine (numba) agent-steps/s | numpy loop agent-steps/s | speed-up |")
     print("|---|---|---|---|")
     for agents in (4, 30):
@@ -135,6 +140,8 @@ def main() -> None:
     terrain_in_runs_table()
     print()
     safety_table(args.steps)
+    print()
+    wall_detail_table()
 
 
 def run_rate(agents: int, seeds: int, **overrides: object) -> float:
@@ -200,6 +207,23 @@ def terrain_in_runs_table(seeds: int = 3) -> None:
             print(
                 f"| {agents} | {name} | {empty:,.0f} | {off:,.0f} | {on:,.0f} | {empty / on:.2f}× the cost | kernel only |"
             )
+
+
+def wall_detail_table(seeds: int = 3, agents: int = 4) -> None:
+    """Issue 34: the kernel over whole runs on each real map (scenarios/real, fetched by ./go maps), the filter
+    on, with walls kept to the map's pixel (``wall_detail = "map"``, the default) against whole cells."""
+    print(f"| map | N | walls to whole cells, agent-steps/s | to the pixel | cost | whole runs, seeds 0-{seeds - 1} |")
+    print("|---|---|---|---|---|---|")
+    for name in ("uwb-lab", "malaga-campus"):
+        path = PAPER_SCENARIO.parent / "real" / f"{name}.toml"
+        try:
+            load_scenario(path)
+        except ScenarioError as error:  # the map is not fetched: say so, measure the rest
+            print(f"| {name} | {agents} | – | – | – | not measured: {error} |")
+            continue
+        cells = kernel_rate_in_runs(path, agents, seeds, wall_detail="cell")
+        pixels = kernel_rate_in_runs(path, agents, seeds)
+        print(f"| {name} | {agents} | {cells:,.0f} | {pixels:,.0f} | {cells / pixels:.2f}× | kernel only |")
 
 
 def safety_table(steps: int) -> None:

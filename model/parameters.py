@@ -64,15 +64,18 @@ def free_initial_poses(
     reachable: np.ndarray | None = None,
     spacing: float | None = None,
     clear_edges: bool = False,
+    reachable_cell: float | None = None,
 ) -> np.ndarray:
     """Poses (N, 3) drawn from ``seed`` as :func:`initial_poses` draws them (all x, all y, all θ, over
     the grid's extent), keeping each robot whose disk is on the grid, ``clearance`` away from occupied
-    cells (and, ``clear_edges``, from the grid's edge), at least 2·radius + ``spacing`` (default: clearance)
-    from the robots kept before it, and (given ``reachable``) in a reachable cell; the others are drawn again, in rounds, in id order. On a grid with no occupied cell
+    squares of side ``cell`` (and, ``clear_edges``, from the grid's edge), at least 2·radius + ``spacing``
+    (default: clearance) from the robots kept before it, and (given ``reachable``, on cells of
+    ``reachable_cell``, default ``cell``) in a reachable cell; the others are drawn again, in rounds, in id order. On a grid with no occupied cell
     and point robots every pose is kept at once: the poses are exactly :func:`initial_poses`'s. Raises
     ValueError when the free space cannot hold the team."""
     rng = np.random.default_rng(seed)
     spacing = clearance if spacing is None else spacing
+    reach_cell = cell if reachable_cell is None else reachable_cell
     rows, cols = occupied.shape
     poses = np.zeros((agents, 3))
     placed: list[int] = []
@@ -85,7 +88,7 @@ def free_initial_poses(
         thetas = rng.uniform(-math.pi, math.pi, len(pending))
         still: list[int] = []
         for agent, x, y, theta in zip(pending, xs, ys, thetas, strict=True):
-            if _start_is_free(occupied, cell, x, y, radius, clearance, reachable, clear_edges) and all(
+            if _start_is_free(occupied, cell, x, y, radius, clearance, reachable, reach_cell, clear_edges) and all(
                 math.hypot(x - poses[other, 0], y - poses[other, 1]) >= 2.0 * radius + spacing for other in placed
             ):
                 poses[agent] = (x, y, theta)
@@ -107,14 +110,17 @@ def _start_is_free(
     radius: float,
     clearance: float,
     reachable: np.ndarray | None,
+    reachable_cell: float,
     clear_edges: bool,
 ) -> bool:
-    rows, cols = occupied.shape
     if not disk_is_free(occupied, x, y, radius, cell, True):
         return False
     if clearance > 0.0 and not disk_is_free(occupied, x, y, radius + clearance, cell, clear_edges):
         return False
-    return reachable is None or bool(reachable[min(int(y / cell), rows - 1), min(int(x / cell), cols - 1)])
+    if reachable is None:
+        return True
+    rows, cols = reachable.shape
+    return bool(reachable[min(int(y / reachable_cell), rows - 1), min(int(x / reachable_cell), cols - 1)])
 
 
 START_CLEARANCE = 0.5
@@ -137,8 +143,8 @@ def starting_poses(scenario: Scenario) -> np.ndarray:
         clearance = max(clearance, scenario.safety_margin)
         spacing = max(spacing, scenario.safety_margin + 4.0 * scenario.lookahead)
     return free_initial_poses(
-        world.occupied,
-        scenario.cell,
+        world.wall_grid,
+        world.grain,
         scenario.agents,
         scenario.seed,
         scenario.robot_radius,
@@ -146,6 +152,7 @@ def starting_poses(scenario: Scenario) -> np.ndarray:
         world.reachable,
         spacing,
         clear_edges=scenario.filters and world.ground.bounded,
+        reachable_cell=scenario.cell,
     )
 
 

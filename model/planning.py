@@ -63,7 +63,17 @@ def path_lengths(world: World, positions: np.ndarray, objectives: np.ndarray) ->
         field = world.field(goal_x, goal_y)
         for i, (x, y) in enumerate(positions):
             lengths[i, j] = path_length(
-                field, ground.occupied, x, y, goal_x, goal_y, cell, ground.plan_radius, ground.bounded, lengths[i, j]
+                field,
+                ground.wall_grid,
+                ground.grain,
+                x,
+                y,
+                goal_x,
+                goal_y,
+                cell,
+                ground.plan_radius,
+                ground.bounded,
+                lengths[i, j],
             )
     return lengths
 
@@ -108,7 +118,9 @@ def _uncovered_in_sight(world: World, lack: np.ndarray, x: float, y: float) -> i
             if lack[r, c] <= 0.0:
                 continue
             cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
-            if np.hypot(cx - x, cy - y) < reach and not segment_crosses_occupied(world.occupied, x, y, cx, cy, cell):
+            if np.hypot(cx - x, cy - y) < reach and not segment_crosses_occupied(
+                world.wall_grid, x, y, cx, cy, world.grain
+            ):
                 count += 1
     return count
 

@@ -146,7 +146,7 @@ def decide_and_sense(
 @njit(cache=True)
 def _step_is_free(x: float, y: float, theta: float, v: float, omega: float, law: LawParameters, ground: Ground) -> bool:
     next_x, next_y, _ = unicycle_step(x, y, theta, v, omega, law.dt)
-    return disk_is_free(ground.occupied, next_x, next_y, ground.wall_clearance, law.cell, ground.bounded)
+    return disk_is_free(ground.wall_grid, next_x, next_y, ground.wall_clearance, ground.grain, ground.bounded)
 
 
 def load_kernels(coverage: np.ndarray, pose: tuple[float, float, float], law: LawParameters, ground: Ground) -> None:
@@ -185,5 +185,7 @@ def move(
     """The pose after one step, eq. 1; on a terrain a step that would put the disk over a wall (or off
     the map) is not taken as a move, only as a turn (:func:`model.world.clearance.step_or_stay`)."""
     if ground.walls or ground.bounded:
-        return step_or_stay(ground.occupied, x, y, theta, v, omega, law.dt, ground.radius, law.cell, ground.bounded)
+        return step_or_stay(
+            ground.wall_grid, x, y, theta, v, omega, law.dt, ground.radius, ground.grain, ground.bounded
+        )
     return unicycle_step(x, y, theta, v, omega, law.dt)

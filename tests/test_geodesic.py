@@ -46,7 +46,7 @@ def test_the_radius_narrows_the_free_space():
 def test_with_the_objective_in_sight_the_global_law_is_the_papers():
     free = np.zeros((40, 40), dtype=bool)
     field = distance_fields(~free, [(30, 30)], 1.0)[0]
-    assert descent_waypoint(field, ~free, free, 5.0, 7.0, 30.5, 30.5, 1.0, 20, 0.5, True) == (
+    assert descent_waypoint(field, ~free, free, 1.0, 5.0, 7.0, 30.5, 30.5, 1.0, 20, 0.5, True) == (
         math.hypot(25.5, 23.5),
         30.5,
         30.5,
@@ -63,7 +63,7 @@ def test_following_the_waypoints_gets_round_the_wall_where_heading_straight_stal
         x, y, theta = 5.5, 5.5, 0.0
         for _ in range(1500):
             target = (
-                descent_waypoint(field, passable, occupied, x, y, *goal, 1.0, 20, radius, True)[1:]
+                descent_waypoint(field, passable, occupied, 1.0, x, y, *goal, 1.0, 20, radius, True)[1:]
                 if aim_at_waypoints
                 else goal
             )
@@ -87,9 +87,9 @@ def test_a_robot_inside_the_planning_margin_joins_the_graph_beside_it_instead_of
     field = distance_fields(passable, [(5, 30)], 1.0)[0]
     x, y = 19.3, 5.5  # 0.7 from the wall (r + s): its cell's centre is 0.5 off it, not passable
     assert math.isinf(field[5, 19])
-    row, col = entry_cell(field, occupied, x, y, 1.0, planning_radius, True)
+    row, col = entry_cell(field, occupied, 1.0, x, y, 1.0, planning_radius, True)
     assert (row, col) != (-1, -1) and math.isfinite(field[row, col]) and abs(col - 19) <= 2
-    distance, _, waypoint_y = descent_waypoint(field, passable, occupied, x, y, *goal, 1.0, 20, 0.75, True)
+    distance, _, waypoint_y = descent_waypoint(field, passable, occupied, 1.0, x, y, *goal, 1.0, 20, 0.75, True)
     assert math.isfinite(distance) and distance > 2 * (32 - 5)  # round the wall's end, not through it
     assert waypoint_y > y  # up, toward the gap: not at the goal behind the wall
-    assert length_by_field(field, occupied, x, y, 1.0, planning_radius, True) == distance
+    assert length_by_field(field, occupied, 1.0, x, y, 1.0, planning_radius, True) == distance

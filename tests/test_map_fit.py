@@ -165,5 +165,8 @@ def test_initial_poses_and_objectives_are_read_in_the_maps_frame(tmp_path):
     gaps = [np.hypot(float(row["x"]) + 1.5, float(row["y"]) - 0.5) for row in rows]
     assert gaps[0] > 1.5 and min(gaps) <= scenario.range / 2 + 0.05  # eq. 10 stops it R/2 short
     (tmp_path / "s.toml").write_text(text + "initial_poses = [[3.0, 2.0, 90.0]]\n")
-    with pytest.raises(ScenarioError, match=r"'initial_poses': entry 0 \[3.0, 2.0\] lies outside the domain \(in the map's frame\) \[-6\.6"):
+    with pytest.raises(
+        ScenarioError,
+        match=r"'initial_poses': entry 0 \[3.0, 2.0\] lies outside the domain \(in the map's frame\) \[-6\.6",
+    ):
         load_scenario(tmp_path / "s.toml")

@@ -33,7 +33,7 @@ def test_the_pruned_wedge_hides_exactly_what_the_rule_hides(seed, theta, radius)
     )
     positions = np.array([[x, y], *rng.uniform(0.0, 40.0, (3, 2)), *(np.array([x, y]) + around)])
     coverage = np.zeros((40, 40), dtype=np.int64)
-    ground = Ground(occupied, ~occupied, radius, radius, radius, False, True, True, 20)
+    ground = Ground(occupied, ~occupied, radius, radius, radius, False, True, True, 20, occupied, 1.0)
     blind = ground._replace(occlusion=False)
     e_seen, *_, row0, col0, seen = sense_wedge(
         coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, positions, 0
@@ -79,7 +79,7 @@ def test_pruning_is_exact_on_grid_lines_corners_and_diagonals(seed, quarter_x, q
     x, y = quarter_x / 4.0, quarter_y / 4.0
     occupied[int(y), int(x)] = False
     coverage = np.zeros((40, 40), dtype=np.int64)
-    ground = Ground(occupied, ~occupied, 0.0, 0.0, 0.0, False, True, True, 20)
+    ground = Ground(occupied, ~occupied, 0.0, 0.0, 0.0, False, True, True, 20, occupied, 1.0)
     positions = np.array([[x, y]])
     *_, row0, col0, seen = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, positions, 0)
     blind = ground._replace(occlusion=False)
@@ -100,7 +100,7 @@ def test_teammates_beside_and_behind_hide_exactly_what_the_rule_hides(seed, thet
     around = rng.uniform(1.2, 5.0, 5)[:, None] * np.stack([np.cos(angles), np.sin(angles)], 1)
     positions = np.array([[x, y], *(np.array([x, y]) + around)])
     coverage = np.zeros((40, 40), dtype=np.int64)
-    ground = Ground(occupied, ~occupied, 0.6, 0.6, 0.6, False, True, True, 20)
+    ground = Ground(occupied, ~occupied, 0.6, 0.6, 0.6, False, True, True, 20, occupied, 1.0)
     *_, row0, col0, seen = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, positions, 0)
     blind = ground._replace(occlusion=False)
     *_, _, _, everything = sense_wedge(coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, blind, NO_POSITIONS, 0)
@@ -117,7 +117,7 @@ def test_a_diagonal_through_grid_corners_is_pruned_as_the_traversal_decides():
     x, y, theta = 24.75, 15.25, -math.pi / 4
     occupied[int(y), int(x)] = False
     coverage = np.zeros((40, 40), dtype=np.int64)
-    ground = Ground(occupied, ~occupied, 0.0, 0.0, 0.0, False, True, True, 20)
+    ground = Ground(occupied, ~occupied, 0.0, 0.0, 0.0, False, True, True, 20, occupied, 1.0)
     *_, row0, col0, seen = sense_wedge(
         coverage, TARGET, x, y, theta, R, F, ALPHA, 0.1, 1.0, ground, np.array([[x, y]]), 0
     )

@@ -96,7 +96,9 @@ def test_delta_window_lies_inside_grid_and_is_non_negative(x, y, theta):
 
 
 def _ground(occupied: np.ndarray, radius: float = 0.0, occlusion: bool = True) -> Ground:
-    return Ground(occupied, ~occupied, radius, radius, radius, False, bool(occupied.any()), occlusion, 20)
+    return Ground(
+        occupied, ~occupied, radius, radius, radius, False, bool(occupied.any()), occlusion, 20, occupied, 1.0
+    )
 
 
 def _ticks_at(window: tuple, row: int, col: int) -> int:

@@ -19,7 +19,9 @@ TARGET = 100
 
 
 def ground_of(occupied: np.ndarray, radius: float = 0.5, occlusion: bool = True) -> Ground:
-    return Ground(occupied, ~occupied, radius, radius + 0.05, radius, True, bool(occupied.any()), occlusion, 20)
+    return Ground(
+        occupied, ~occupied, radius, radius + 0.05, radius, True, bool(occupied.any()), occlusion, 20, occupied, 1.0
+    )
 
 
 def one_uncovered_cell(row: int, col: int, shape=(20, 20)) -> np.ndarray:

@@ -103,3 +103,83 @@ def test_a_priority_map_gives_each_cell_its_own_target(tmp_path):
     assert (coverage_map.coverage[:, 10:] == 0).all()
     assert coverage_map.domain_error() == pytest.approx((100 * 0.2 * 100 + 100 * 100) / (200 * 100))
     assert world.summary()["priority_sha256"]
+
+
+def two_rooms_map(folder, crack: bool = True, resolution: float = 0.08):
+    """A map_saver-like map 16 × 8 m, walls one pixel thick: a west room opens to the east one by a door 1.76 m
+    wide; in the east's north-east corner a third room, 4 × 3.2 m, is closed but (``crack``) for a crack one
+    pixel wide. Drawn in 0.08 m pixels (10 a cell of 0.8 m), or, ``resolution`` 0.16, in pixels twice as big."""
+    scale = round(resolution / 0.08)
+    image = np.full((100, 200), 254, dtype=np.uint8)  # image rows count from the top
+    image[[0, -1], :] = 0
+    image[:, [0, -1]] = 0
+    image[:, 99] = 0  # the wall between the west and east rooms: cell column 9
+    image[40:62, 99] = 254  # its door: y from 3.04 to 4.8 m
+    image[40, 150:] = 0  # the closed room's south wall (cell row 5) and west wall (cell column 15)
+    image[:40, 150] = 0
+    image = image[::scale, ::scale].copy()  # (at 0.16 m every wall drawn above keeps one pixel)
+    if crack:
+        image[20 // scale, 150 // scale] = 254
+    cv2.imwrite(str(folder / "rooms.pgm"), image)
+    (folder / "rooms.yaml").write_text(
+        f"image: rooms.pgm\nmode: trinary\nresolution: {resolution}\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    return folder / "rooms.yaml"
+
+
+def rooms_scenario(folder, crack: bool = True, resolution: float = 0.08, **keys) -> Scenario:
+    """The campus scenario's robot and camera (r 0.3 m, s 0.1 m, R 8 m, 0.8 m cells) on :func:`two_rooms_map`."""
+    folder.mkdir(exist_ok=True)
+    values = {
+        "map": str(two_rooms_map(folder, crack, resolution)),
+        "cell": 0.8,
+        "range": 8.0,
+        "robot_radius": 0.3,
+        "safety_margin": 0.1,
+        "lookahead": 0.3,
+        "k_v": 0.5,
+        "k_omega": 0.48,
+        "agents": 1,
+    }
+    return validate(values | keys, folder)
+
+
+def test_walls_kept_to_the_map_s_pixel_let_a_robot_through_a_door_that_whole_cells_close(tmp_path):
+    fine = world_of(rooms_scenario(tmp_path))
+    coarse = world_of(rooms_scenario(tmp_path, wall_detail="cell"))
+    # Wall squares of 0.16 m: 5 a cell side, the largest divisor of the 10 pixels a cell up to 5.
+    assert fine.grain == pytest.approx(0.16) and coarse.grain == 0.8
+    assert (fine.occupied == coarse.occupied).all()  # what there is to cover is the same
+    west, east = np.s_[:, :9], np.s_[:5, 10:]
+    # On whole cells the door's jambs are cells of wall: the 1.76 m door is 1.6 m of free cells, too little for
+    # a robot 0.88 m wide with its margins between cell centres 0.8 apart. To the pixel the centre at y = 3.6
+    # is 0.56 m off the jamb.
+    assert fine.reachable[west].any() and fine.reachable[east].any()
+    assert coarse.reachable[west].any() != coarse.reachable[east].any()
+    assert fine.coverable[west].all() == (~fine.occupied[west]).all() and fine.coverable[east].sum() > 0
+    assert fine.unreachable_cells < coarse.unreachable_cells
+
+
+@pytest.mark.parametrize("resolution", [0.08, 0.16])
+def test_no_coverable_cell_is_seen_only_through_a_one_pixel_crack(tmp_path, resolution):
+    # At 0.16 m the wall squares are the pixels themselves (5 a cell): only the gap's closing seals the crack.
+    cracked = world_of(rooms_scenario(tmp_path / "cracked", resolution=resolution))
+    sealed = world_of(rooms_scenario(tmp_path / "sealed", crack=False, resolution=resolution))
+    assert cracked.grain == pytest.approx(0.16)
+    inside = np.s_[6:9, 16:19]  # the closed room's free cells (row 9 holds the map's edge, column 19 too)
+    assert not cracked.occupied[inside].any()
+    assert not cracked.coverable[inside].any()
+    assert (cracked.coverable == sealed.coverable).all()
+
+
+def test_walls_drawn_on_whole_cells_keep_the_world_fitted_to_cells(tmp_path):
+    image = np.full((40, 40), 254, dtype=np.uint8)
+    image[10:20, 10:20] = 0  # a block of 2 × 2 cells of 5 pixels
+    cv2.imwrite(str(tmp_path / "block.pgm"), image)
+    (tmp_path / "block.yaml").write_text(
+        "image: block.pgm\nmode: trinary\nresolution: 0.1\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    world = world_of(validate({"map": "block.yaml", "cell": 0.5, "robot_radius": 0.2}, tmp_path))
+    assert world.grain == 0.5 and world.wall_grid is world.wall_grid and world.wall_grid.shape == world.occupied.shape

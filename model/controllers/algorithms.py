@@ -54,7 +54,12 @@ class Planner(TeamPlanner):
         if len(self.blobs.positions) and self.blobs.cells is not None:
             objectives = blob_targets(self.blobs, lack, self.scenario.cell)
         places = viewpoints(
-            world.occupied, world.reachable, objectives, viewing_range_of(self.scenario), self.scenario.cell
+            world.wall_grid,
+            world.grain,
+            world.reachable,
+            objectives,
+            viewing_range_of(self.scenario),
+            self.scenario.cell,
         )
         lengths = path_lengths(world, positions, places)
         choice = assign_objectives(positions, places, lengths)

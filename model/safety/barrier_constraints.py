@@ -157,7 +157,7 @@ def safe_velocities(
     x, y, theta = poses[me, 0], poses[me, 1], poses[me, 2]
     ahead = safety.lookahead
     px, py = x + ahead * math.cos(theta), y + ahead * math.sin(theta)
-    window = math.ceil(2.0 * (safety.radius + safety.margin + 2.0 * safety.v_max * safety.dt) / cell) + 2
+    window = math.ceil(2.0 * (safety.radius + safety.margin + 2.0 * safety.v_max * safety.dt) / ground.grain) + 2
     capacity = 8 + poses.shape[0] + 2 * window * window
     gx, gy, c = np.zeros(capacity), np.zeros(capacity), np.zeros(capacity)
     # The paper's bounds |v| ≤ k_v, |ω| ≤ π·k_ω, in z = (v, l·ω).
@@ -171,7 +171,7 @@ def safe_velocities(
         binding = binding or gx[k] * v_hat + gy[k] * ahead * omega_hat < c[k]
     normals = np.zeros((capacity, 2))
     first_wall = count
-    count = _walls(gx, gy, c, normals, count, x, y, theta, ground.occupied, cell, ground.bounded, safety)
+    count = _walls(gx, gy, c, normals, count, x, y, theta, ground.wall_grid, ground.grain, ground.bounded, safety)
     target_v = math.cos(turn) * v_hat - math.sin(turn) * ahead * omega_hat
     target_l = math.sin(turn) * v_hat + math.cos(turn) * ahead * omega_hat
     feasible, v, lw = project_onto_polygon(gx, gy, c, count, target_v, target_l)

@@ -121,7 +121,7 @@ def min_clearance(positions: np.ndarray, ground: Ground, cell: float) -> float |
         return None
     cap = float(max(ground.occupied.shape) * cell)
     xs, ys = positions[..., 0].ravel(), positions[..., 1].ravel()
-    return float(_least_clearance(ground.occupied, xs, ys, cap, cell, ground.bounded))
+    return float(_least_clearance(ground.wall_grid, xs, ys, cap, ground.grain, ground.bounded))
 
 
 def safety_figures(

@@ -53,6 +53,7 @@ class Scenario:
     # Terrain (issue 11); the defaults are the paper's open world and leave every run as it was.
     map: str = ""  # a ROS map YAML, absolute (the file names it relative to itself); "" = none
     obstacles: tuple[tuple[tuple[float, float], ...], ...] = ()  # polygons [[x, y], ...]
+    wall_detail: str = "map"  # walls to the map's pixel ("map", up to 5 squares a cell side) or to whole cells ("cell")
     robot_radius: float = 0.0  # r: a robot is a disk (0: the paper's point robot)
     occlusion: bool = True  # walls and teammates' disks hide what lies behind them
     priority_map: str = ""  # an image whose grey level gives Λ*(x) from lambda_star_min to lambda_star
@@ -141,7 +142,7 @@ class Scenario:
 
 
 UNIT_KEYS = ("metres_per_unit", "seconds_per_unit")
-TERRAIN_KEYS = ("map", "obstacles", "robot_radius", "occlusion", "priority_map", "lambda_star_min")
+TERRAIN_KEYS = ("map", "obstacles", "wall_detail", "robot_radius", "occlusion", "priority_map", "lambda_star_min")
 _OPEN_WORLD = Scenario()
 
 _POSITIVE_FLOATS = (
@@ -172,6 +173,15 @@ def _boolean(key: str, value: Any) -> bool:
     return value
 
 
+def _domain(value: Any) -> tuple[float, float]:
+    if not isinstance(value, list | tuple) or len(value) != 2:
+        raise ScenarioError(f"scenario key 'domain': expected [width, height], got {value!r}")
+    width, height = (_number("domain", item) for item in value)
+    if width <= 0 or height <= 0:
+        raise ScenarioError(f"scenario key 'domain': expected positive sizes, got {value!r}")
+    return width, height
+
+
 def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
     """Build a Scenario from a mapping, checking every key; raise ScenarioError naming the bad one.
     Files the scenario names (``map``, a priority map) are relative to ``base`` (the scenario's folder)."""
@@ -198,12 +208,7 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
             except RadioKeyError as error:
                 raise ScenarioError(str(error)) from error
         elif key == "domain":
-            if not isinstance(value, list | tuple) or len(value) != 2:
-                raise ScenarioError(f"scenario key 'domain': expected [width, height], got {value!r}")
-            width, height = (_number("domain", item) for item in value)
-            if width <= 0 or height <= 0:
-                raise ScenarioError(f"scenario key 'domain': expected positive sizes, got {value!r}")
-            resolved[key] = (width, height)
+            resolved[key] = _domain(value)
         elif key in ("agents", "seed"):
             if isinstance(value, bool) or not isinstance(value, int):
                 raise ScenarioError(f"scenario key '{key}': expected an integer, got {value!r}")
@@ -219,7 +224,9 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
         elif key == "watchdog_time":
             patience = _number(key, value)
             if patience < 0.0:
-                raise ScenarioError(f"scenario key 'watchdog_time': expected 0 (automatic) or a positive time, got {value!r}")
+                raise ScenarioError(
+                    f"scenario key 'watchdog_time': expected 0 (automatic) or a positive time, got {value!r}"
+                )
             resolved[key] = patience
         elif key == "half_angle_deg":
             angle = _number(key, value)

@@ -9,6 +9,9 @@ naming the key or the file (the scenario loader reports it as a scenario error).
   of pixels). The model's domain starts at (0, 0) at the fitted map's lower-left corner; what a user reads
   (trajectory.csv, a ROS 2 base's frames) is in the map's own frame.
 - ``obstacles = [[[x, y], ...], ...]``: polygons, with or without a map.
+- ``wall_detail = "map"`` (the default) or ``"cell"``: how finely bodies and cameras meet the walls
+  (:func:`model.world.world.grain_split_of`): to the map's pixel, up to 5 squares a cell side, or to whole
+  cells (a cell with any wall pixel is a wall: the fit before issue 34, kept by the drawn maps' studies).
 - ``robot_radius`` (≥ 0) and ``occlusion`` (true or false).
 - ``lambda_star = "priority.png"`` with ``lambda_star_min`` and ``lambda_star_max``: a priority map,
   grey level 0 → the minimum, 255 → the maximum.
@@ -95,6 +98,8 @@ def resolve_terrain_keys(values: dict[str, Any], base: Path) -> dict[str, Any]:
             tuple((float(x), float(y)) for x, y in check_polygon(index, polygon))
             for index, polygon in enumerate(polygons)
         )
+    if "wall_detail" in values and values["wall_detail"] not in ("map", "cell"):
+        raise TerrainError(f'scenario key \'wall_detail\': expected "map" or "cell", got {values["wall_detail"]!r}')
     if "robot_radius" in values:
         values["robot_radius"] = _finite("robot_radius", values["robot_radius"], 0.0)
     if "occlusion" in values and not isinstance(values["occlusion"], bool):

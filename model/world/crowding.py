@@ -85,7 +85,7 @@ def _own_place(
     cell, sensing_range = world.scenario.cell, viewing_range_of(world.scenario)
     row, col = math.floor(target[1] / cell), math.floor(target[0] / cell)
     centre_x, centre_y = (col + 0.5) * cell, (row + 0.5) * cell  # what coverable means (viewpoints does the same)
-    found = seers(world.occupied, world.reachable, centre_x, centre_y, sensing_range, cell)
+    found = seers(world.wall_grid, world.grain, world.reachable, centre_x, centre_y, sensing_range, cell)
     order = np.argsort(np.hypot(found[:, 1] - position[0], found[:, 2] - position[1]), kind="stable")
     for _, x, y in found[order]:
         if _clear_of(np.array((x, y)), taken, spacing):

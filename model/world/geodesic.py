@@ -30,14 +30,29 @@ from model.world.visibility import segment_crosses_occupied
 NEIGHBOURS = ((0, 1), (1, 0), (0, -1), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
 
 
+def passable_cells(
+    wall_grid: np.ndarray,
+    radius: float,
+    cell: float,
+    bounded: bool,
+    grain: float | None = None,
+    shape: tuple[int, int] | None = None,
+) -> np.ndarray:
+    """Coverage cells (``shape``, side ``cell``) whose centre can hold the robot's disk among the wall squares
+    (side ``grain``); by default the wall squares are the cells themselves."""
+    grain, shape = (cell, wall_grid.shape) if grain is None or shape is None else (grain, shape)
+    return _passable_centres(wall_grid, radius, cell, bounded, grain, shape[0], shape[1])
+
+
 @njit(cache=True)
-def passable_cells(occupied: np.ndarray, radius: float, cell: float, bounded: bool) -> np.ndarray:
-    """Cells whose centre can hold the robot's disk."""
-    rows, cols = occupied.shape
+def _passable_centres(
+    wall_grid: np.ndarray, radius: float, cell: float, bounded: bool, grain: float, rows: int, cols: int
+) -> np.ndarray:
     passable = np.zeros((rows, cols), dtype=np.bool_)
     for row in range(rows):
         for col in range(cols):
-            passable[row, col] = disk_is_free(occupied, (col + 0.5) * cell, (row + 0.5) * cell, radius, cell, bounded)
+            x, y = (col + 0.5) * cell, (row + 0.5) * cell
+            passable[row, col] = disk_is_free(wall_grid, x, y, radius, grain, bounded)
     return passable
 
 
@@ -61,6 +76,43 @@ def grid_graph(passable: np.ndarray, cell: float) -> coo_matrix:
     return coo_matrix((np.concatenate(costs), (np.concatenate(sources), np.concatenate(targets))), shape=(size, size))
 
 
+def passage_graph(
+    passable: np.ndarray, cell: float, wall_grid: np.ndarray, grain: float, radius: float, bounded: bool
+) -> coo_matrix:
+    """:func:`grid_graph`, less the steps the disk of ``radius`` cannot drive straight among wall squares finer
+    than the cell: two passable centres may hold the disk with a thin wall between them. With squares of a
+    whole cell the graph's own rule settles it (a wall between two neighbours is a cell that is not passable)."""
+    graph = grid_graph(passable, cell)
+    if wall_grid.shape == passable.shape:
+        return graph
+    cols = passable.shape[1]
+    keep = _drivable(graph.row, graph.col, cols, cell, wall_grid, grain, radius, bounded)
+    return coo_matrix((graph.data[keep], (graph.row[keep], graph.col[keep])), shape=graph.shape)
+
+
+@njit(cache=True)
+def _drivable(
+    sources: np.ndarray,
+    targets: np.ndarray,
+    cols: int,
+    cell: float,
+    wall_grid: np.ndarray,
+    grain: float,
+    radius: float,
+    bounded: bool,
+) -> np.ndarray:
+    keep = np.zeros(sources.shape[0], dtype=np.bool_)
+    for k in range(sources.shape[0]):
+        low, high = (
+            min(sources[k], targets[k]),
+            max(sources[k], targets[k]),
+        )  # each way alike: the graph stays symmetric
+        x0, y0 = (low % cols + 0.5) * cell, (low // cols + 0.5) * cell
+        x1, y1 = (high % cols + 0.5) * cell, (high // cols + 0.5) * cell
+        keep[k] = swept_disk_is_free(wall_grid, x0, y0, x1, y1, radius, grain, bounded)
+    return keep
+
+
 def distance_fields(
     passable: np.ndarray, goals: list[tuple[int, int]], cell: float, graph: csr_matrix | None = None
 ) -> np.ndarray:
@@ -78,18 +130,18 @@ def distance_fields(
 
 
 OWN_CLEARANCE_SLACK = 1e-9
-"""How much of its own clearance, in cells, a robot inside the planning margin leaves out of the drive's disk
+"""How much of its own clearance, in wall squares, a robot inside the planning margin leaves out of the drive's disk
 test (:func:`in_sight`): far above rounding, far below anything a robot could hit."""
 
 
 @njit(cache=True)
 def in_sight(
-    occupied: np.ndarray,
+    wall_grid: np.ndarray,
     x: float,
     y: float,
     target_x: float,
     target_y: float,
-    cell: float,
+    grain: float,
     radius: float,
     bounded: bool,
 ) -> bool:
@@ -100,19 +152,20 @@ def in_sight(
     short (OWN_CLEARANCE_SLACK): measured from the very point the drive starts at, rounding made the start
     itself fail the test, and a robot the filter held exactly r + s off a door's jamb found no drive at all
     and headed straight into the jamb for the rest of the run (issue 34, the lab map, N = 2 seed 4)."""
-    if segment_crosses_occupied(occupied, x, y, target_x, target_y, cell):
+    if segment_crosses_occupied(wall_grid, x, y, target_x, target_y, grain):
         return False
-    clearance = clearance_within(occupied, x, y, radius, cell, bounded)
+    clearance = clearance_within(wall_grid, x, y, radius, grain, bounded)
     if clearance < radius:
-        clearance -= OWN_CLEARANCE_SLACK * cell
-    return clearance <= 0.0 or swept_disk_is_free(occupied, x, y, target_x, target_y, clearance, cell, bounded)
+        clearance -= OWN_CLEARANCE_SLACK * grain
+    return clearance <= 0.0 or swept_disk_is_free(wall_grid, x, y, target_x, target_y, clearance, grain, bounded)
 
 
 @njit(cache=True)
 def descent_waypoint(
     field: np.ndarray,
     passable: np.ndarray,
-    occupied: np.ndarray,
+    wall_grid: np.ndarray,
+    grain: float,
     x: float,
     y: float,
     objective_x: float,
@@ -123,10 +176,10 @@ def descent_waypoint(
     bounded: bool,
 ) -> tuple[float, float, float]:
     """(distance, waypoint x, waypoint y) for the global law at (x, y) (see the module's docstring)."""
-    if in_sight(occupied, x, y, objective_x, objective_y, cell, radius, bounded):
+    if in_sight(wall_grid, x, y, objective_x, objective_y, grain, radius, bounded):
         return math.hypot(objective_x - x, objective_y - y), objective_x, objective_y
     rows, cols = field.shape
-    row, col = entry_cell(field, occupied, x, y, cell, radius, bounded)
+    row, col = entry_cell(field, wall_grid, grain, x, y, cell, radius, bounded)
     if row < 0:
         return math.hypot(objective_x - x, objective_y - y), objective_x, objective_y  # cut off: head straight
     waypoint_x, waypoint_y = (col + 0.5) * cell, (row + 0.5) * cell
@@ -151,7 +204,7 @@ def descent_waypoint(
         steps += 1
     for k in range(steps - 1, -1, -1):  # the farthest first: usually in sight along a corridor
         centre_x, centre_y = (walk[k, 1] + 0.5) * cell, (walk[k, 0] + 0.5) * cell
-        if in_sight(occupied, x, y, centre_x, centre_y, cell, radius, bounded):
+        if in_sight(wall_grid, x, y, centre_x, centre_y, grain, radius, bounded):
             waypoint_x, waypoint_y = centre_x, centre_y
             break
     return distance, waypoint_x, waypoint_y
@@ -160,7 +213,8 @@ def descent_waypoint(
 @njit(cache=True)
 def path_length(
     field: np.ndarray,
-    occupied: np.ndarray,
+    wall_grid: np.ndarray,
+    grain: float,
     x: float,
     y: float,
     goal_x: float,
@@ -173,18 +227,25 @@ def path_length(
     """Length of the shortest free path from (x, y) to the goal: ``straight`` (its straight distance)
     when a straight drive gets there, else the goal's field at the robot's cell plus the way to that
     cell's centre (:func:`length_by_field`, as :func:`descent_waypoint` measures it); +inf when the goal cannot be reached."""
-    if in_sight(occupied, x, y, goal_x, goal_y, cell, radius, bounded):
+    if in_sight(wall_grid, x, y, goal_x, goal_y, grain, radius, bounded):
         return straight
-    return length_by_field(field, occupied, x, y, cell, radius, bounded)
+    return length_by_field(field, wall_grid, grain, x, y, cell, radius, bounded)
 
 
 @njit(cache=True)
 def length_by_field(
-    field: np.ndarray, occupied: np.ndarray, x: float, y: float, cell: float, radius: float, bounded: bool
+    field: np.ndarray,
+    wall_grid: np.ndarray,
+    grain: float,
+    x: float,
+    y: float,
+    cell: float,
+    radius: float,
+    bounded: bool,
 ) -> float:
     """The field at the entry cell of (x, y) (:func:`entry_cell`) plus the way from (x, y) to its centre;
     +inf if there is none."""
-    row, col = entry_cell(field, occupied, x, y, cell, radius, bounded)
+    row, col = entry_cell(field, wall_grid, grain, x, y, cell, radius, bounded)
     if row < 0:
         return math.inf
     return field[row, col] + math.hypot((col + 0.5) * cell - x, (row + 0.5) * cell - y)
@@ -196,7 +257,14 @@ ENTRY_RINGS = 2
 
 @njit(cache=True)
 def entry_cell(
-    field: np.ndarray, occupied: np.ndarray, x: float, y: float, cell: float, radius: float, bounded: bool
+    field: np.ndarray,
+    wall_grid: np.ndarray,
+    grain: float,
+    x: float,
+    y: float,
+    cell: float,
+    radius: float,
+    bounded: bool,
 ) -> tuple[int, int]:
     """Where the robot at (x, y) joins the graph of passable cells: its own cell when the field is finite
     there; else, within ENTRY_RINGS rings, the cell in sight (:func:`in_sight`, which allows a robot
@@ -216,6 +284,6 @@ def entry_cell(
                 continue
             centre_x, centre_y = (c + 0.5) * cell, (r + 0.5) * cell
             total = field[r, c] + math.hypot(centre_x - x, centre_y - y)
-            if total < best and in_sight(occupied, x, y, centre_x, centre_y, cell, radius, bounded):
+            if total < best and in_sight(wall_grid, x, y, centre_x, centre_y, grain, radius, bounded):
                 best, best_row, best_col = total, r, c
     return best_row, best_col

@@ -17,7 +17,7 @@ by a step one rounding error off it, or by the arc of a unicycle that is not yet
 
 
 class Ground(NamedTuple):
-    occupied: np.ndarray  # bool (rows, cols)
+    occupied: np.ndarray  # bool (rows, cols): coverage cells with a wall in them (nothing there to cover)
     passable: np.ndarray  # bool (rows, cols): centres that hold the robot's disk
     radius: float  # r
     plan_radius: float  # wall_clearance plus PLANNING_MARGIN: what paths and straight drives are planned with
@@ -26,12 +26,14 @@ class Ground(NamedTuple):
     walls: bool  # an occupied cell: the global law and the assignment go round them
     occlusion: bool  # lines of sight are tested (walls, or teammates' disks when r > 0)
     lookahead: int  # cells walked down a distance field for the global law's waypoint
+    wall_grid: np.ndarray  # bool (rows·k, cols·k): the walls as bodies and cameras meet them, squares of ``grain``
+    grain: float  # side of a wall_grid square: the cell, or a whole fraction of it (model.world.world.grain_of)
 
 
 def open_ground() -> Ground:
     """No wall, no body, nothing hidden: the paper's world."""
     nothing = np.zeros((1, 1), dtype=np.bool_)
-    return Ground(nothing, ~nothing, 0.0, 0.0, 0.0, False, False, False, 1)
+    return Ground(nothing, ~nothing, 0.0, 0.0, 0.0, False, False, False, 1, nothing, 1.0)
 
 
 NO_FIELD = np.zeros((1, 1))

@@ -55,24 +55,27 @@ def wall_shadows(
     shadows = np.full((2, SHADOW_BINS), np.inf)
     if not ground.occlusion:
         return shadows
-    rows, cols = ground.occupied.shape
+    walls, grain = ground.wall_grid, ground.grain
+    rows, cols = walls.shape
     heading_x, heading_y = math.cos(theta), math.sin(theta)
     reach2 = sensing_range * sensing_range
     cos_half_angle, sin_half_angle = math.cos(half_angle), math.sin(half_angle)
     # The window of the wedge's cells and the robot's own cell: a segment between them stays inside.
-    row0, row1 = min(row0, math.floor(y / cell)), max(row1, math.floor(y / cell) + 1)
-    col0, col1 = min(col0, math.floor(x / cell)), max(col1, math.floor(x / cell) + 1)
+    # The wall squares of that window (a coverage cell holds split × split of them).
+    split = round(cell / grain)
+    row0, row1 = min(row0, math.floor(y / cell)) * split, (max(row1, math.floor(y / cell) + 1)) * split
+    col0, col1 = min(col0, math.floor(x / cell)) * split, (max(col1, math.floor(x / cell) + 1)) * split
     for row in range(max(row0, 0), min(row1, rows)):
         for col in range(max(col0, 0), min(col1, cols)):
-            if not ground.occupied[row, col] or _inside_a_wall(ground.occupied, row, col, rows, cols):
+            if not walls[row, col] or _inside_a_wall(walls, row, col, rows, cols):
                 continue  # a segment reaches a cell inside a wall only through the wall cells around it
-            left, bottom = col * cell - x, row * cell - y
-            nearest2 = square_gap2(left, bottom, cell)
+            left, bottom = col * grain - x, row * grain - y
+            nearest2 = square_gap2(left, bottom, grain)
             if nearest2 > reach2 or _past_an_edge(
-                left, bottom, cell, heading_x, heading_y, cos_half_angle, sin_half_angle
+                left, bottom, grain, heading_x, heading_y, cos_half_angle, sin_half_angle
             ):
                 continue  # farther than R, or no bearing of it in the wedge
-            smallest, largest, farthest2, behind = _square_span(left, bottom, cell, heading_x, heading_y)
+            smallest, largest, farthest2, behind = _square_span(left, bottom, grain, heading_x, heading_y)
             if nearest2 == 0.0:
                 # The robot stands on its edge: the traversal's tie rules (a segment from a grid corner)
                 # may test it whatever the bearing.

@@ -2,9 +2,10 @@
 
 A pose is reachable when its cell is passable (:func:`model.world.geodesic.passable_cells`) and connected to
 a robot's start through passable cells (the 8-connected graph of :mod:`model.world.geodesic`, no corner
-cutting). A free cell is coverable when its centre lies closer than the viewing range (R less a cell:
-:func:`model.world.world.viewing_range_of`, passed in as ``sensing_range``) to the centre of a reachable
-cell with a clear line of sight (:func:`model.world.visibility.segment_crosses_occupied`): the robot can turn
+cutting, or its :func:`model.world.geodesic.passage_graph`). A free cell is coverable when its centre lies
+closer than the viewing range (R less a cell: :func:`model.world.world.viewing_range_of`, passed in as
+``sensing_range``) to the centre of a reachable cell with a clear line of sight past the wall squares
+(:func:`model.world.visibility.segment_crosses_occupied`; squares of ``grain``, the cell unless given): the robot can turn
 its camera any way, and eq. 2 gives α = 0 at r = R. Occupied cells and the rest of the free cells
 (an enclosed room, a pocket narrower than the robot) are left out of e_D and of completion.
 """
@@ -15,23 +16,34 @@ import math
 
 import numpy as np
 from numba import njit
+from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from model.scenario.terrain import coarsen
 from model.world.geodesic import grid_graph
 from model.world.visibility import segment_crosses_occupied
 
 
-def reachable_cells(passable: np.ndarray, starts: list[tuple[int, int]], cell: float) -> np.ndarray:
-    """Passable cells connected to any of the start cells."""
+def reachable_cells(
+    passable: np.ndarray, starts: list[tuple[int, int]], cell: float, graph: coo_matrix | None = None
+) -> np.ndarray:
+    """Passable cells connected to any of the start cells (by ``graph``, else :func:`grid_graph`)."""
     rows, cols = passable.shape
-    _, labels = connected_components(grid_graph(passable, cell), directed=False)
+    _, labels = connected_components(grid_graph(passable, cell) if graph is None else graph, directed=False)
     labels = labels.reshape(rows, cols)
     start_labels = {labels[row, col] for row, col in starts if passable[row, col]}
     return np.isin(labels, list(start_labels)) & passable
 
 
 @njit(cache=True)
-def _seen_from(occupied: np.ndarray, reachable: np.ndarray, sensing_range: float, cell: float) -> np.ndarray:
+def _seen_from(
+    occupied: np.ndarray,
+    wall_grid: np.ndarray,
+    grain: float,
+    reachable: np.ndarray,
+    sensing_range: float,
+    cell: float,
+) -> np.ndarray:
     """Free cells within R of a reachable cell's centre in clear sight. A reachable cell sees itself;
     any other free cell looks for one reachable centre, stopping at the first (most cells are near one)."""
     rows, cols = occupied.shape
@@ -50,7 +62,7 @@ def _seen_from(occupied: np.ndarray, reachable: np.ndarray, sensing_range: float
                     x, y = (c + 0.5) * cell, (r + 0.5) * cell
                     if math.hypot(tx - x, ty - y) >= sensing_range:
                         continue
-                    if not segment_crosses_occupied(occupied, x, y, tx, ty, cell):
+                    if not segment_crosses_occupied(wall_grid, x, y, tx, ty, grain):
                         found = True
                         break
                 if found:
@@ -60,10 +72,19 @@ def _seen_from(occupied: np.ndarray, reachable: np.ndarray, sensing_range: float
 
 
 def coverable_cells(
-    occupied: np.ndarray, passable: np.ndarray, starts: list[tuple[int, int]], sensing_range: float, cell: float
+    wall_grid: np.ndarray,
+    passable: np.ndarray,
+    starts: list[tuple[int, int]],
+    sensing_range: float,
+    cell: float,
+    grain: float | None = None,
+    graph: coo_matrix | None = None,
 ) -> np.ndarray:
     """Free cells some reachable pose can see (see the module's docstring)."""
-    return _seen_from(occupied, reachable_cells(passable, starts, cell), sensing_range, cell)
+    grain = cell if grain is None else grain
+    occupied = coarsen(wall_grid, round(cell / grain))
+    reachable = reachable_cells(passable, starts, cell, graph)
+    return _seen_from(occupied, wall_grid, grain, reachable, sensing_range, cell)
 
 
 def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) -> np.ndarray:
@@ -84,11 +105,17 @@ def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) ->
 
 @njit(cache=True)
 def seers(
-    occupied: np.ndarray, reachable: np.ndarray, x: float, y: float, sensing_range: float, cell: float
+    wall_grid: np.ndarray,
+    grain: float,
+    reachable: np.ndarray,
+    x: float,
+    y: float,
+    sensing_range: float,
+    cell: float,
 ) -> np.ndarray:
     """The reachable cells that see the point (x, y): closer than R, clear sight from the centre, as
     coverable cells are defined. (M, 3) rows (gap, centre x, centre y), nearest first, row order on a tie."""
-    rows, cols = occupied.shape
+    rows, cols = reachable.shape
     span = math.ceil(sensing_range / cell)
     row, col = math.floor(y / cell), math.floor(x / cell)
     found = np.empty(((2 * span + 1) ** 2, 3))
@@ -99,7 +126,7 @@ def seers(
                 continue
             cx, cy = (c + 0.5) * cell, (r + 0.5) * cell
             gap = math.hypot(cx - x, cy - y)
-            if gap < sensing_range and not segment_crosses_occupied(occupied, cx, cy, x, y, cell):
+            if gap < sensing_range and not segment_crosses_occupied(wall_grid, cx, cy, x, y, grain):
                 found[count, 0], found[count, 1], found[count, 2] = gap, cx, cy
                 count += 1
     order = np.argsort(found[:count, 0], kind="mergesort")  # stable: row order on a tie
@@ -107,7 +134,12 @@ def seers(
 
 
 def viewpoints(
-    occupied: np.ndarray, reachable: np.ndarray, points: np.ndarray, sensing_range: float, cell: float
+    wall_grid: np.ndarray,
+    grain: float,
+    reachable: np.ndarray,
+    points: np.ndarray,
+    sensing_range: float,
+    cell: float,
 ) -> np.ndarray:
     """Where a robot goes to cover each point (K, 2) (an objective of Algorithm 1, on an uncovered cell): the
     point itself when its cell is reachable, else the centre of the nearest reachable cell that sees its cell's
@@ -124,7 +156,7 @@ def viewpoints(
         # From the cell's centre: coverable cells are those a reachable centre sees centre to centre, and
         # a viewpoint of a point off the centre (Algorithm 1's centroid) may see that point but not the cell.
         centre_x, centre_y = (col + 0.5) * cell, (row + 0.5) * cell
-        seen_from = seers(occupied, reachable, centre_x, centre_y, sensing_range, cell)
+        seen_from = seers(wall_grid, grain, reachable, centre_x, centre_y, sensing_range, cell)
         if len(seen_from):
             moved[k] = seen_from[0, 1:]
         else:

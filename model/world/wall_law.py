@@ -54,19 +54,7 @@ def global_law_among_walls(
     """(u_glo, θ_glo*) on a terrain, from the open world's (``u_glo``, ``theta_glo``): see the module.
     ``teammates`` (K, 2): the other robots' positions whose disks may hide a cell (occlusion). ``look`` (2,):
     the centre of the cell the robot looked at in the step before (NaN: none), read and written."""
-    distance, waypoint_x, waypoint_y = descent_waypoint(
-        field,
-        ground.passable,
-        ground.occupied,
-        x,
-        y,
-        objective_x,
-        objective_y,
-        cell,
-        ground.lookahead,
-        ground.plan_radius,
-        ground.bounded,
-    )
+    distance, waypoint_x, waypoint_y = _waypoint(field, ground, x, y, objective_x, objective_y, cell)
     detour = waypoint_x != objective_x or waypoint_y != objective_y
     if not detour and _covered_cell(coverage, target_ticks, ground, objective_x, objective_y, cell):
         # A viewpoint (model.world.reachability.viewpoints: a covered cell from which the blob is seen), or a
@@ -94,6 +82,18 @@ def global_law_among_walls(
         # nearer, at eq. 10's speed for this distance taken positive, rather than wait for ever.
         return abs(u_glo), math.atan2(objective_y - y, objective_x - x)
     return 0.0, math.atan2(look_y - y, look_x - x)
+
+
+@njit(cache=True)
+def _waypoint(
+    field: np.ndarray, ground: Ground, x: float, y: float, objective_x: float, objective_y: float, cell: float
+) -> tuple[float, float, float]:
+    """:func:`model.world.geodesic.descent_waypoint` on this ground."""
+    passable, walls, grain = ground.passable, ground.wall_grid, ground.grain
+    lookahead, radius, bounded = ground.lookahead, ground.plan_radius, ground.bounded
+    return descent_waypoint(
+        field, passable, walls, grain, x, y, objective_x, objective_y, cell, lookahead, radius, bounded
+    )
 
 
 @njit(cache=True)
@@ -145,9 +145,7 @@ def cell_to_look_at(
         ):
             return look_x, look_y
     hiding = teammates if ground.occlusion else teammates[:0]
-    return _nearest_uncovered_in_sight(
-        coverage, target_ticks, ground.occupied, hiding, ground.radius, x, y, sensing_range, cell
-    )
+    return _nearest_uncovered_in_sight(coverage, target_ticks, ground, hiding, x, y, sensing_range, cell)
 
 
 @njit(cache=True)
@@ -176,9 +174,8 @@ def _objective_cell_in_sight(
 def _nearest_uncovered_in_sight(
     coverage: np.ndarray,
     target_ticks: int,
-    occupied: np.ndarray,
+    ground: Ground,
     hiding: np.ndarray,
-    radius: float,
     x: float,
     y: float,
     sensing_range: float,
@@ -197,6 +194,7 @@ def _nearest_uncovered_in_sight(
     # a robot among walls tests a few lines, not every cell within R.
     # Gaps are compared squared, as rounded (no square root per cell): of two cells at the same true
     # distance, the smaller rounded square is the nearer, and of equal ones the first in row-major order.
+    occupied, wall_grid, grain, radius = ground.occupied, ground.wall_grid, ground.grain, ground.radius
     beyond = np.full(LOOK_BINS, np.inf)
     reach2 = sensing_range * sensing_range
     best2, best_index, best_x, best_y = reach2, rows * cols, math.nan, math.nan
@@ -216,9 +214,9 @@ def _nearest_uncovered_in_sight(
                     if gap2 < reach2 and (gap2 < best2 or (gap2 == best2 and index < best_index)):
                         # (A robot on the cell's centre sees it: no bearing, nothing between.)
                         if gap2 == 0.0 or gap2 <= beyond[_look_bin(dx, dy)]:
-                            wall_row, wall_col = first_occupied_crossed(occupied, x, y, cx, cy, cell)
+                            wall_row, wall_col = first_occupied_crossed(wall_grid, x, y, cx, cy, grain)
                             if wall_row >= 0:
-                                _shadow_behind(beyond, wall_col * cell - x, wall_row * cell - y, cell)
+                                _shadow_behind(beyond, wall_col * grain - x, wall_row * grain - y, grain)
                             elif not hidden_by_teammates(hiding, radius, x, y, cx, cy):
                                 best2, best_index, best_x, best_y = gap2, index, cx, cy
                 r, c = r + d_row, c + d_col
@@ -312,4 +310,4 @@ def _in_clear_sight(
 ) -> bool:
     """The camera's rule (model.world.visibility.line_of_sight), teammates' disks only with occlusion."""
     hiding = teammates if ground.occlusion else teammates[:0]
-    return line_of_sight(ground.occupied, x, y, target_x, target_y, cell, hiding, ground.radius)
+    return line_of_sight(ground.wall_grid, x, y, target_x, target_y, ground.grain, hiding, ground.radius)

@@ -140,7 +140,7 @@ def _sweep(
                 if distance2 > near and (
                     distance2 > beyond
                     or hidden_by_teammates(teammates, ground.radius, x, y, target_x, target_y)
-                    or segment_crosses_occupied(ground.occupied, x, y, target_x, target_y, cell)
+                    or segment_crosses_occupied(ground.wall_grid, x, y, target_x, target_y, ground.grain)
                 ):
                     # Hidden, yet in S_Ω if in the wedge: no arctangent where the cone's cheap test settles it.
                     surely = along >= distance * (cos_half_angle + SURELY_IN_CONE)
