@@ -46,7 +46,7 @@ from model.paper.fixed_point import COVERAGE_SCALE
 from model.safety.safety import DEADLOCK_FOUND, DEADLOCK_RESOLVED
 from model.safety.safety_record import ACTIVE as FILTER_ACTIVE
 from model.scenario import Scenario
-from model.world.world import map_corner_of, world_of
+from model.world.world import map_frame_of, world_of
 
 APPLICATION_ID = "anicov"
 TRAIL_STEPS = 500
@@ -333,8 +333,8 @@ def record_result(result, path: Path, recording_id: str, map_every: int = 50) ->
         recorder.lack_map(round(time / result.scenario.dt), snapshot / 255.0)  # 8-bit snapshots
     recorder.lack_map(result.steps, result.final_lack)
     recorder.domain_errors(result.errors)
-    corner = map_corner_of(result.scenario)
+    frame = map_frame_of(result.scenario)
     for stall in result.stalls:
-        recorder.event(round(stall.time / result.scenario.dt), stall.line(result.scenario.cell, corner), level="WARN")
+        recorder.event(round(stall.time / result.scenario.dt), stall.line(result.scenario.cell, frame), level="WARN")
     recorder.event(result.steps, "run complete" if result.completed else "run stopped at max_time")
     recorder.close()

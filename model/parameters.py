@@ -15,7 +15,7 @@ from model.safety.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
 from model.scenario.safety_keys import point_speed
 from model.world.clearance import disk_is_free
-from model.world.world import map_corner_of, world_of
+from model.world.world import map_frame_of, world_of
 
 
 def exact_kernel_of(scenario: Scenario) -> ExactKernel | None:
@@ -131,8 +131,10 @@ def starting_poses(scenario: Scenario) -> np.ndarray:
     """The team's poses at t_0: :func:`initial_poses` in the open world; on a terrain drawn in the team's
     space, clear of walls and of each other (:func:`free_initial_poses`). ValueError: no room."""
     if scenario.initial_poses:  # in the map's frame, with a map (model.scenario.safety_keys)
-        corner_x, corner_y = map_corner_of(scenario)
-        return np.array([(x - corner_x, y - corner_y, math.radians(theta)) for x, y, theta in scenario.initial_poses])
+        frame = map_frame_of(scenario)
+        given = np.array(scenario.initial_poses, dtype=np.float64)
+        model_x, model_y = frame.from_map(given[:, 0], given[:, 1])
+        return np.stack([model_x, model_y, frame.heading_from_map(np.radians(given[:, 2]))], axis=1)
     world = world_of(scenario)
     if world.open:
         return initial_poses(scenario)

@@ -27,8 +27,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from model.scenario.map_fit import MapFrame
+
 ReasonFunction = Callable[[int, tuple[float, float], tuple[float, float], float], str]
 """(agent, position, objective, path since the last progress) → why the robot made no progress, in words."""
+
+
+def _rounded(point: tuple[float, float]) -> list[float]:
+    return [round(float(point[0]), 4), round(float(point[1]), 4)]
 
 
 @dataclass(frozen=True)
@@ -41,12 +47,12 @@ class RobotStall:
     moved: float  # path length since the last progress (units)
     reason: str
 
-    def as_dict(self, corner: tuple[float, float]) -> dict[str, object]:
-        """For summary.json: positions in the map's frame (``corner``: the model's (0, 0) there)."""
+    def as_dict(self, frame: MapFrame) -> dict[str, object]:
+        """For summary.json: positions in the map's frame."""
         return {
             "agent": self.agent,
-            "position": [round(self.position[0] + corner[0], 4), round(self.position[1] + corner[1], 4)],
-            "objective": [round(self.objective[0] + corner[0], 4), round(self.objective[1] + corner[1], 4)],
+            "position": _rounded(frame.to_map(*self.position)),
+            "objective": _rounded(frame.to_map(*self.objective)),
             "moved": round(self.moved, 4),
             "reason": self.reason,
         }
@@ -61,23 +67,21 @@ class Stall:
     cells: tuple[tuple[int, int], ...]  # (row, col)
     robots: tuple[RobotStall, ...]
 
-    def as_dict(self, cell: float, corner: tuple[float, float]) -> dict[str, object]:
+    def as_dict(self, cell: float, frame: MapFrame) -> dict[str, object]:
         return {
             "time": round(self.time, 6),
             "action": self.action,
             "cells": len(self.cells),
-            "cell_centres": [
-                [round((col + 0.5) * cell + corner[0], 4), round((row + 0.5) * cell + corner[1], 4)]
-                for row, col in self.cells
-            ],
-            "robots": [robot.as_dict(corner) for robot in self.robots],
+            "cell_centres": [_rounded(frame.to_map((col + 0.5) * cell, (row + 0.5) * cell)) for row, col in self.cells],
+            "robots": [robot.as_dict(frame) for robot in self.robots],
         }
 
-    def line(self, cell: float, corner: tuple[float, float]) -> str:
-        """One line for the console and the recording."""
+    def line(self, cell: float, frame: MapFrame) -> str:
+        """One line for the console and the recording (positions in the map's frame)."""
         robots = "; ".join(
-            f"robot {r.agent} at ({r.position[0] + corner[0]:.2f}, {r.position[1] + corner[1]:.2f}) "
-            f"for ({r.objective[0] + corner[0]:.2f}, {r.objective[1] + corner[1]:.2f}): {r.reason}"
+            "robot {} at ({:.2f}, {:.2f}) for ({:.2f}, {:.2f}): {}".format(
+                r.agent, *frame.to_map(*r.position), *frame.to_map(*r.objective), r.reason
+            )
             for r in self.robots
         )
         return f"watchdog at t = {self.time:.1f}: no progress; {len(self.cells)} cells {self.action}. {robots}"

@@ -10,10 +10,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Circle
+from matplotlib.transforms import Affine2D, Transform
 
 from model.run import RunResult
 from model.scenario import Scenario
-from model.world.world import map_corner_of, world_of
+from model.world.world import map_frame_of, world_of
 
 
 def plot_domain_error(result: RunResult, path: Path) -> None:
@@ -53,21 +54,28 @@ def plot_velocities(result: RunResult, path: Path) -> None:
 
 def plot_coverage_maps(result: RunResult, path: Path) -> None:
     """Fig. 6: lack of coverage Υ at four times, with the trajectories so far (and the walls, on a terrain).
-    With a map, in the map's own frame (as trajectory.csv: the model's plus the fitted map's corner)."""
+    With a map, in the map's own frame (as trajectory.csv: the model's placed at the fitted map's corner and
+    turned by its yaw)."""
     scenario = result.scenario
     width, height = scenario.domain
-    x0, y0 = map_corner_of(scenario)
-    box = (x0, x0 + width, y0, y0 + height)
+    frame = map_frame_of(scenario)
+    box = (0.0, width, 0.0, height)  # the model's domain, placed in the map's frame by each axes' transform
+    outline_x, outline_y = frame.to_map(
+        np.array([0.0, width, width, 0.0, 0.0]), np.array([0.0, 0.0, height, height, 0.0])
+    )
+    low_x, high_x, low_y, high_y = outline_x.min(), outline_x.max(), outline_y.min(), outline_y.max()
     last = len(result.snapshots) - 1
     picks = sorted({round(last * fraction) for fraction in (0.25, 0.5, 0.75, 1.0)})
     fig, axes = plt.subplots(1, len(picks), figsize=(3.3 * len(picks), 3.6), squeeze=False)
     for ax, pick in zip(axes[0], picks, strict=True):
         time = result.snapshot_times[pick]
-        ax.imshow(result.snapshots[pick] / 255.0, origin="lower", extent=box, cmap="gray_r", vmin=0.0, vmax=1.0)
-        draw_obstacles(ax, scenario, box)
+        placed = Affine2D().rotate(frame.yaw).translate(*frame.corner) + ax.transData
+        shown = result.snapshots[pick] / 255.0
+        ax.imshow(shown, origin="lower", extent=box, cmap="gray_r", vmin=0.0, vmax=1.0, transform=placed)
+        draw_obstacles(ax, scenario, box, placed)
         upto = min(round(time / scenario.dt) + 1, len(result.trace))
         for agent in range(scenario.agents):
-            xs, ys = result.trace[:upto, agent, 0] + x0, result.trace[:upto, agent, 1] + y0
+            xs, ys = frame.to_map(result.trace[:upto, agent, 0], result.trace[:upto, agent, 1])
             (line,) = ax.plot(xs, ys, linewidth=0.6)
             if scenario.robot_radius > 0.0:  # the robot's disk, to scale (issue 12)
                 ax.add_patch(
@@ -75,11 +83,9 @@ def plot_coverage_maps(result: RunResult, path: Path) -> None:
                 )
             else:
                 ax.plot(xs[-1], ys[-1], "o", markersize=5, mfc="none", color=line.get_color())
-        ax.plot(
-            [box[0], box[1], box[1], box[0], box[0]], [box[2], box[2], box[3], box[3], box[2]], "k--", linewidth=0.8
-        )
-        ax.set_xlim(x0 - 0.1 * width, x0 + 1.1 * width)
-        ax.set_ylim(y0 - 0.1 * height, y0 + 1.1 * height)
+        ax.plot(outline_x, outline_y, "k--", linewidth=0.8)
+        ax.set_xlim(low_x - 0.1 * (high_x - low_x), high_x + 0.1 * (high_x - low_x))
+        ax.set_ylim(low_y - 0.1 * (high_y - low_y), high_y + 0.1 * (high_y - low_y))
         ax.set_aspect("equal")
         ax.set_title(f"t = {time:.0f}")
         if scenario.map:
@@ -90,16 +96,18 @@ def plot_coverage_maps(result: RunResult, path: Path) -> None:
     plt.close(fig)
 
 
-def draw_obstacles(ax: plt.Axes, scenario: Scenario, box: tuple[float, float, float, float]) -> None:
+def draw_obstacles(
+    ax: plt.Axes, scenario: Scenario, box: tuple[float, float, float, float], placed: Transform | None = None
+) -> None:
     """Occupied cells in brown, and free cells nobody can see hatched (nothing, in the open world), over
-    ``box`` (left, right, bottom, top)."""
+    ``box`` (left, right, bottom, top), placed by the transform ``placed`` (default: the axes' data)."""
     world = world_of(scenario)
     if world.open:
         return
     layers = np.zeros((*world.occupied.shape, 4))
     layers[world.occupied] = (0.45, 0.27, 0.1, 1.0)
     layers[~world.occupied & ~world.coverable] = (0.2, 0.4, 0.9, 0.55)
-    ax.imshow(layers, origin="lower", extent=box, interpolation="nearest")
+    ax.imshow(layers, origin="lower", extent=box, interpolation="nearest", transform=placed or ax.transData)
 
 
 def write_run_plots(result: RunResult, out_dir: Path) -> list[Path]:

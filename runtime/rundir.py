@@ -18,7 +18,8 @@ from model.paper.metrics import optimum_time, total_sensing_ability
 from model.planning import default_patience
 from model.run import RunResult
 from model.safety.safety_record import safety_figures
-from model.world.world import World, map_corner_of, world_of
+from model.scenario.map_fit import MapFrame
+from model.world.world import World, map_frame_of, world_of
 
 TRAJECTORY_HEADER = "t,agent,x,y,theta,v,omega"
 
@@ -31,10 +32,11 @@ def step_time(step: int, dt: float) -> float:
 def write_trajectory(result: RunResult, path: Path) -> None:
     """One row per agent per step (pose at the start, (v, ω) during), then the final poses with v = ω = 0.
     On a map, positions are in the map's own frame (what RViz shows): the model's, plus where its (0, 0)
-    lies (:func:`model.world.world.map_corner_of`; nothing is added when it is the map frame's origin)."""
+    lies, and headings turned by its yaw (:func:`model.world.world.map_frame_of`; nothing changes in the map
+    frame's own)."""
     dt = result.scenario.dt
-    corner_x, corner_y = map_corner_of(result.scenario)
-    shifted = (corner_x, corner_y) != (0.0, 0.0)
+    frame = map_frame_of(result.scenario)
+    shifted = frame != MapFrame()
     lines = [TRAJECTORY_HEADER]
     for step, rows in enumerate(result.trace):
         t = repr(step_time(step, dt))
@@ -42,7 +44,7 @@ def write_trajectory(result: RunResult, path: Path) -> None:
             if x != x:  # NaN: a realtime run that never heard this agent's state for this step
                 continue
             if shifted:
-                x, y = x + corner_x, y + corner_y
+                (x, y), theta = frame.to_map(x, y), float(frame.heading_to_map(theta))
             lines.append(f"{t},{agent},{x!r},{y!r},{theta!r},{v!r},{omega!r}")
     path.write_text("\n".join(lines) + "\n", encoding="ascii")
 
@@ -86,11 +88,11 @@ def watchdog_report(result: RunResult, world: World) -> dict[str, Any]:
     why: given up by the watchdog (with the robots' reasons in its interventions), or time ran out. Cell
     centres in the map's frame."""
     scenario = result.scenario
-    corner = map_corner_of(scenario)
+    frame = map_frame_of(scenario)
     left = (result.final_lack > 0.0) & world.coverable
     given_up = result.given_up if result.given_up is not None else np.zeros_like(left)
     centres = [
-        [round((col + 0.5) * scenario.cell + corner[0], 4), round((row + 0.5) * scenario.cell + corner[1], 4)]
+        [round(float(v), 4) for v in frame.to_map((col + 0.5) * scenario.cell, (row + 0.5) * scenario.cell)]
         for row, col in np.argwhere(left)
     ]
     why = "completed" if result.completed else (
@@ -100,7 +102,7 @@ def watchdog_report(result: RunResult, world: World) -> dict[str, Any]:
     return {
         "enabled": scenario.watchdog,
         "patience": (scenario.watchdog_time or default_patience(world)) if scenario.watchdog else None,
-        "interventions": [stall.as_dict(scenario.cell, corner) for stall in result.stalls],
+        "interventions": [stall.as_dict(scenario.cell, frame) for stall in result.stalls],
         "cells_left": int(left.sum()),
         "cells_given_up": int((left & given_up).sum()),
         "why": why,

@@ -15,9 +15,9 @@ import pytest
 
 from anicov.engine import run_scenario
 from model.scenario import ScenarioError, load_scenario
-from model.scenario.map_fit import MARGIN_CELLS, fit_to_cells
+from model.scenario.map_fit import MARGIN_CELLS, MapFrame, fit_to_cells
 from model.scenario.terrain import coarsen, load_occupancy_map, map_on_grid
-from model.world.world import map_corner_of, world_of
+from model.world.world import map_frame_of, map_note_of, world_of
 from runtime.rundir import write_run_directory
 from tests.teamrun import ROOT, limit
 
@@ -26,7 +26,7 @@ ORIGIN = (-10.0, -12.3)
 RESOLUTION = 0.05
 
 
-def saved_map(folder, rows=423, cols=286):
+def saved_map(folder, rows=423, cols=286, yaw=0.0):
     """A map_saver-like map: 0.05 m pixels, unknown everywhere but a 6.05 × 4.05 m room (121 × 81 pixels, an
     odd number of each: no cell of 0.1 m fits it whole), its walls one pixel thick with a one-pixel gap, an
     unknown island and a round pillar inside."""
@@ -40,7 +40,7 @@ def saved_map(folder, rows=423, cols=286):
     cv2.imwrite(str(folder / "saved.pgm"), image)
     (folder / "saved.yaml").write_text(
         "image: saved.pgm\nmode: trinary\nresolution: 0.05\n"
-        f"origin: [{ORIGIN[0]}, {ORIGIN[1]}, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+        f"origin: [{ORIGIN[0]}, {ORIGIN[1]}, {yaw}]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
     )
     room_bottom_row = rows - (top + height)  # the room's lowest pixel row, counted from the bottom
     return folder / "saved.yaml", (left, room_bottom_row, width, height)
@@ -94,8 +94,8 @@ def test_a_cell_that_is_not_whole_pixels_is_refused_by_key(tmp_path):
         load_scenario(tmp_path / "s.toml")
 
 
-def scenario_on_saved_map(tmp_path):
-    path, _ = saved_map(tmp_path)
+def scenario_on_saved_map(tmp_path, yaw=0.0):
+    path, _ = saved_map(tmp_path, yaw=yaw)
     (tmp_path / "s.toml").write_text(
         f'map = "{path.name}"\ncell = 0.1\nagents = 1\nseed = 3\nrange = 1.2\nhalf_angle_deg = 30.0\n'
         "robot_radius = 0.105\nk_v = 0.22\nk_omega = 0.9\nmax_time = 6000.0\n"
@@ -105,7 +105,7 @@ def scenario_on_saved_map(tmp_path):
 
 def test_a_run_on_a_saved_map_completes_with_its_poses_in_the_maps_frame(tmp_path):
     scenario = scenario_on_saved_map(tmp_path)
-    corner = map_corner_of(scenario)
+    corner = map_frame_of(scenario).corner
     assert scenario.domain[0] < 6.6 and corner != (0.0, 0.0)
     world = world_of(scenario)
     # The one-pixel gap and the island: no coverable cell outside the room's walls is reached through it.
@@ -144,7 +144,9 @@ def test_another_cell_refits_the_map_with_its_own_domain_and_corner(tmp_path):
     coarser = scenario.with_overrides(cell=0.2)
     path, _ = saved_map(tmp_path)
     fitted = fit_to_cells(load_occupancy_map(path), 0.2)
-    assert coarser.domain == pytest.approx(fitted.extent) and map_corner_of(coarser) == pytest.approx(fitted.corner)
+    assert coarser.domain == pytest.approx(fitted.extent) and map_frame_of(coarser).corner == pytest.approx(
+        fitted.corner
+    )
     assert coarser.grid_shape == (fitted.occupied.shape[0] // 4, fitted.occupied.shape[1] // 4)
     with pytest.raises(ScenarioError, match=r"'domain': the map .* spans"):
         scenario.with_overrides(cell=0.2, domain=list(scenario.domain))
@@ -170,3 +172,39 @@ def test_initial_poses_and_objectives_are_read_in_the_maps_frame(tmp_path):
         match=r"'initial_poses': entry 0 \[3.0, 2.0\] lies outside the domain \(in the map's frame\) \[-6\.6",
     ):
         load_scenario(tmp_path / "s.toml")
+
+
+def test_a_map_turned_by_its_origin_s_yaw_keeps_poses_in_its_own_frame(tmp_path):
+    """map_saver's origin [x, y, yaw]: the image's x axis lies at yaw in the map's frame. Poses given and written
+    are in that frame: the model's turned by the yaw about the fitted corner, which the crop moved along the
+    turned axes."""
+    yaw = 0.5
+    (tmp_path / "flat").mkdir()
+    unturned = fit_to_cells(load_occupancy_map(saved_map(tmp_path / "flat")[0]), 0.1)
+    cropped_x, cropped_y = unturned.corner[0] - ORIGIN[0], unturned.corner[1] - ORIGIN[1]
+    turned = MapFrame(
+        (
+            ORIGIN[0] + np.cos(yaw) * cropped_x - np.sin(yaw) * cropped_y,
+            ORIGIN[1] + np.sin(yaw) * cropped_x + np.cos(yaw) * cropped_y,
+        ),
+        yaw,
+    )
+    scenario_on_saved_map(tmp_path, yaw=yaw)
+    text = (tmp_path / "s.toml").read_text().replace("max_time = 6000.0", "max_time = 40.0")
+    start, goal = turned.to_map(2.0, 2.0), turned.to_map(4.5, 2.0)  # in the room; heading along the image's x
+    poses = f"initial_poses = [[{start[0]}, {start[1]}, {np.degrees(yaw)}]]\nobjectives = [[{goal[0]}, {goal[1]}]]\n"
+    (tmp_path / "s.toml").write_text(text + poses)
+    scenario = load_scenario(tmp_path / "s.toml")
+    assert map_frame_of(scenario).corner == pytest.approx(turned.corner) and map_frame_of(scenario).yaw == yaw
+    assert "x axis at yaw 0.5 rad" in map_note_of(scenario)
+    result = run_scenario(scenario)
+    assert result.trace[0, 0, :3] == pytest.approx((2.0, 2.0, 0.0))  # the model's frame is the image's
+    summary = write_run_directory(result, tmp_path / "out")
+    assert summary["terrain"]["map_yaw"] == yaw
+    with open(tmp_path / "out" / "trajectory.csv") as source:
+        rows = list(csv.DictReader(source))
+    assert (float(rows[0]["x"]), float(rows[0]["y"]), float(rows[0]["theta"])) == pytest.approx((*start, yaw))
+    xs, ys = np.array([float(r["x"]) for r in rows]), np.array([float(r["y"]) for r in rows])
+    steps = len(result.trace)
+    assert np.allclose(np.stack(turned.from_map(xs, ys), axis=1)[:steps], result.trace[:, 0, :2])
+    assert min(np.hypot(xs - goal[0], ys - goal[1])) <= scenario.range / 2 + 0.05  # it drove to the goal given

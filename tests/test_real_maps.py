@@ -19,7 +19,8 @@ import pytest
 from anicov.engine import run_scenario
 from model.parameters import starting_poses
 from model.scenario import load_scenario
-from model.world.world import fitted_map_of, map_corner_of, world_of
+from model.scenario.map_fit import MapFrame
+from model.world.world import fitted_map_of, map_frame_of, world_of
 from runtime.lifecycle import EXIT_INCOMPLETE
 from runtime.rundir import summary_of
 from tests.conftest import ROOT
@@ -63,7 +64,7 @@ def test_every_corpus_map_loads_as_published_cropped_to_what_is_known_in_its_own
     width, height = scenario.domain
     assert width < cols * occupancy.resolution and height < rows * occupancy.resolution  # the void cropped
     left, _, bottom, _ = fitted.cropped
-    corner = map_corner_of(scenario)
+    corner = map_frame_of(scenario).corner
     assert corner == pytest.approx(
         (occupancy.origin[0] + left * occupancy.resolution, occupancy.origin[1] + bottom * occupancy.resolution)
     )
@@ -76,7 +77,7 @@ def test_a_short_seeded_run_on_the_lab_map_completes():
     map_of(scenario_path)
     # N = 2, seed 1: 2603.9 time units (t* 524.6), about 3 s.
     result = run_scenario(load_scenario(scenario_path).with_overrides(agents=2, seed=1), record_trace=False)
-    assert result.completed, (result.errors[-1], [stall.line(0.2, (0.0, 0.0)) for stall in result.stalls])
+    assert result.completed, (result.errors[-1], [stall.line(0.2, MapFrame()) for stall in result.stalls])
 
 
 def test_a_team_of_eight_completes_the_campus_map():
@@ -86,7 +87,7 @@ def test_a_team_of_eight_completes_the_campus_map():
     map_of(scenario_path)
     scenario = load_scenario(scenario_path).with_overrides(agents=8, seed=0)
     result = run_scenario(scenario)  # with the trace: separation and clearance are measured on it
-    assert result.completed, (result.errors[-1], [stall.line(scenario.cell, (0.0, 0.0)) for stall in result.stalls])
+    assert result.completed, (result.errors[-1], [stall.line(scenario.cell, MapFrame()) for stall in result.stalls])
     assert not result.given_up.any()
     report = summary_of(result)
     assert result.stalls == []
@@ -164,7 +165,7 @@ def test_ros2_bases_drive_the_lab_map_at_a_burger_s_real_units(tmp_path):
     assert summary["min_clearance"] >= scenario.robot_radius and summary["final_error"] < 0.99
     with open(tmp_path / "team" / "trajectory.csv") as source:
         rows = list(csv.DictReader(source))
-    corner = map_corner_of(scenario)
+    corner = map_frame_of(scenario).corner
     starts = starting_poses(scenario)
     world = world_of(scenario)
     for agent in range(2):

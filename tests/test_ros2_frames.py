@@ -48,11 +48,18 @@ def test_a_localiser_pose_and_the_odometry_of_that_instant_give_map_from_odom():
     assert compose(offset, odometry) == pytest.approx(map_pose)
 
 
-@given(coordinates, coordinates)
-def test_map_and_scenario_frames_are_inverse(x, y):
-    frame = ScenarioFrame((-3.5, 12.0), metres_per_unit=0.05, seconds_per_unit=0.2)
+@given(coordinates, coordinates, st.sampled_from([0.0, 0.5, -2.0]))
+def test_map_and_scenario_frames_are_inverse(x, y, yaw):
+    frame = ScenarioFrame((-3.5, 12.0), metres_per_unit=0.05, seconds_per_unit=0.2, yaw=yaw)
     mx, my = frame.to_map(x, y)
-    assert frame.to_scenario((mx, my, 0.3)) == pytest.approx((x, y, 0.3), abs=1e-6)
+    assert frame.to_scenario((mx, my, 0.3 + yaw)) == pytest.approx((x, y, 0.3), abs=1e-6)
+
+
+def test_a_turned_map_turns_the_scenario_s_axes():
+    # A map whose origin has a yaw of 90°: the scenario's x axis is the map frame's y axis.
+    frame = ScenarioFrame((1.0, 2.0), yaw=math.pi / 2)
+    assert frame.to_map(3.0, 0.0) == pytest.approx((1.0, 5.0))
+    assert frame.to_scenario((1.0, 5.0, math.pi / 2)) == pytest.approx((3.0, 0.0, 0.0))
 
 
 def test_velocities_scale_by_the_units():

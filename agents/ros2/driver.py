@@ -40,7 +40,7 @@ from agents.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, Ros2Options
 from agents.ros2.transport import Ros2Topics
 from model.paper.dynamics import unicycle_step
 from model.scenario import Scenario
-from model.world.world import map_corner_of
+from model.world.world import map_frame_of
 
 log = logging.getLogger("anicov.ros2")
 
@@ -54,12 +54,12 @@ ODOMETRY_HISTORY = 256
 
 def frame_of(scenario: Scenario, options: Ros2Options) -> ScenarioFrame:
     """The scenario in the robot's map frame: its (0, 0) at ``origin`` if given, else where the scenario's map
-    puts it (the same Nav2 map: the frames then agree; :func:`model.world.world.map_corner_of`, the map's
-    origin when no unknown border was cropped), else at the map frame's (0, 0); its units."""
-    origin = options.origin
-    if origin is None:
-        origin = map_corner_of(scenario)
-    return ScenarioFrame(origin, scenario.metres_per_unit, scenario.seconds_per_unit)
+    puts it, turned by the map's yaw (the same Nav2 map: the frames then agree; :func:`model.world.world.map_frame_of`,
+    the map's origin when no unknown border was cropped), else at the map frame's (0, 0); its units."""
+    if options.origin is not None:
+        return ScenarioFrame(options.origin, scenario.metres_per_unit, scenario.seconds_per_unit)
+    frame = map_frame_of(scenario)
+    return ScenarioFrame(frame.corner, scenario.metres_per_unit, scenario.seconds_per_unit, frame.yaw)
 
 
 class Ros2Robot:

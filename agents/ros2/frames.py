@@ -2,14 +2,16 @@
 
 ROS states poses in metres and radians in the ``map`` frame (REP 103/105); a scenario states lengths in
 its own units (``metres_per_unit``) and time in its own (``seconds_per_unit``), with its (0, 0) at the
-lower-left corner of its domain. With a Nav2 map the two frames differ only by the map's ``origin``
-(docs/terrain.md: world = model + origin) and the units are metres.
+lower-left corner of its domain. With a Nav2 map the two frames differ by the map's ``origin`` (its x, y
+and yaw: model.scenario.map_fit.MapFrame) and the units are metres.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+from model.scenario.map_fit import MapFrame
 
 Pose = tuple[float, float, float]
 
@@ -36,15 +38,18 @@ class ScenarioFrame:
     origin: tuple[float, float] = (0.0, 0.0)  # map-frame (x, y) of the scenario's (0, 0), metres
     metres_per_unit: float = 1.0
     seconds_per_unit: float = 1.0
+    yaw: float = 0.0  # the scenario's x axis in the map frame (a map whose origin has a yaw), radians
 
     def to_scenario(self, map_pose: Pose) -> Pose:
-        """A map-frame pose (metres) in scenario units; the heading is the same (no rotation between)."""
+        """A map-frame pose (metres) in scenario units; the heading turned by the yaw (none: the same)."""
         x, y, theta = map_pose
-        return (x - self.origin[0]) / self.metres_per_unit, (y - self.origin[1]) / self.metres_per_unit, theta
+        frame = MapFrame(self.origin, self.yaw)
+        model_x, model_y = frame.from_map(x, y)
+        return model_x / self.metres_per_unit, model_y / self.metres_per_unit, float(frame.heading_from_map(theta))
 
     def to_map(self, x: float, y: float) -> tuple[float, float]:
         """A scenario point (units) in the map frame (metres): the inverse of :meth:`to_scenario`."""
-        return self.origin[0] + x * self.metres_per_unit, self.origin[1] + y * self.metres_per_unit
+        return MapFrame(self.origin, self.yaw).to_map(x * self.metres_per_unit, y * self.metres_per_unit)
 
     def to_ros_velocity(self, v: float, omega: float) -> tuple[float, float]:
         """(v, ω) in scenario units per time unit as (m/s, rad/s)."""

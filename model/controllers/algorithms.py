@@ -17,7 +17,7 @@ from model.planning import TeamPlanner, path_lengths
 from model.scenario import Scenario
 from model.world.crowding import spread_shared, team_spacing
 from model.world.reachability import viewpoints
-from model.world.world import map_corner_of, viewing_range_of, world_of
+from model.world.world import map_frame_of, viewing_range_of, world_of
 
 
 @dataclass
@@ -39,7 +39,7 @@ class Planner(TeamPlanner):
         if self.scenario.objectives:  # in the map's frame, with a map (model.scenario.safety_keys)
             ids = range(len(positions)) if members is None else members
             fixed = np.array([self.scenario.objectives[agent] for agent in ids], dtype=np.float64).reshape(-1, 2)
-            return fixed - np.array(map_corner_of(self.scenario))
+            return np.stack(map_frame_of(self.scenario).from_map(fixed[:, 0], fixed[:, 1]), axis=1)
         world = world_of(self.scenario)
         terrain = bool(world.ground.walls)
         self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range, by_paths=terrain)

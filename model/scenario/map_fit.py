@@ -7,10 +7,12 @@ border of unknown).
   cell it would be on the whole image.
 - **Pad**: with unknown pixels (not free, like the map's own unknown) on the right and at the top, up to a
   whole number of cells.
-- **Frame**: the model's domain starts at (0, 0) at the fitted image's lower-left corner; in the map's own
-  frame (REP 105's ``map``, what RViz shows) that corner lies at :attr:`FittedMap.corner`, the map's
-  ``origin`` plus the pixels cropped at the left and bottom. Poses written for a user (trajectory.csv, the
-  ROS 2 bases' odometry and commands) are in the map's frame: the model's plus that corner.
+- **Frame**: the model's domain starts at (0, 0) at the fitted image's lower-left corner, its x axis along
+  the image's rows; in the map's own frame (REP 105's ``map``, what RViz shows) that corner lies at
+  :attr:`FittedMap.corner`, the map's ``origin`` plus the pixels cropped at the left and bottom (turned by
+  the origin's yaw), and the model's x axis at that yaw (:class:`MapFrame`). Poses written for a user
+  (trajectory.csv, the ROS 2 bases' odometry, the watchdog's report) and read from one (``initial_poses``,
+  ``objectives``) are in the map's frame.
 
 Unknown pixels inside the free space (a SLAM map's unscanned islands) stay not free: no robot plans through
 them and no camera sees through them. A map whose known pixels span the whole image and split into whole
@@ -19,7 +21,9 @@ cells is not changed at all.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -28,6 +32,39 @@ from model.scenario.terrain import OccupancyMap, TerrainError
 MARGIN_CELLS = 1
 """Cells of unknown kept around the known pixels when the border is cropped: the outermost walls stay whole
 and a robot's wedge may reach past them (it sees nothing there)."""
+
+
+@dataclass(frozen=True)
+class MapFrame:
+    """Where the model's frame lies in the map's (see the module's docstring): the model's (0, 0) at ``corner``,
+    its x axis at ``yaw`` radians. Without a yaw a point is only shifted (exactly the model's value plus the
+    corner); points and headings may be floats or arrays."""
+
+    corner: tuple[float, float] = (0.0, 0.0)
+    yaw: float = 0.0
+
+    def to_map(self, x: Any, y: Any) -> tuple[Any, Any]:
+        """A model point in the map's frame."""
+        if self.yaw == 0.0:
+            return x + self.corner[0], y + self.corner[1]
+        cos_yaw, sin_yaw = math.cos(self.yaw), math.sin(self.yaw)
+        return self.corner[0] + cos_yaw * x - sin_yaw * y, self.corner[1] + sin_yaw * x + cos_yaw * y
+
+    def from_map(self, x: Any, y: Any) -> tuple[Any, Any]:
+        """A map-frame point in the model's frame."""
+        dx, dy = x - self.corner[0], y - self.corner[1]
+        if self.yaw == 0.0:
+            return dx, dy
+        cos_yaw, sin_yaw = math.cos(self.yaw), math.sin(self.yaw)
+        return cos_yaw * dx + sin_yaw * dy, -sin_yaw * dx + cos_yaw * dy
+
+    def heading_to_map(self, theta: Any) -> Any:
+        """A model heading in the map's frame, in (−π, π] when turned."""
+        return theta if self.yaw == 0.0 else np.remainder(theta + self.yaw + math.pi, 2.0 * math.pi) - math.pi
+
+    def heading_from_map(self, theta: Any) -> Any:
+        """A map-frame heading in the model's frame."""
+        return theta if self.yaw == 0.0 else np.remainder(theta - self.yaw + math.pi, 2.0 * math.pi) - math.pi
 
 
 @dataclass(frozen=True)
@@ -40,6 +77,11 @@ class FittedMap:
     corner: tuple[float, float]  # map-frame (x, y) of the fitted image's lower-left corner
     cropped: tuple[int, int, int, int]  # pixels cut at the left, right, bottom and top
     padded: tuple[int, int]  # pixels of unknown added on the right and at the top
+    yaw: float = 0.0  # the image's x axis in the map's frame (the origin's yaw)
+
+    @property
+    def frame(self) -> MapFrame:
+        return MapFrame(self.corner, self.yaw)
 
     @property
     def extent(self) -> tuple[float, float]:
@@ -49,7 +91,7 @@ class FittedMap:
 
     def note(self, source: OccupancyMap) -> str | None:
         """What the fit changed, for the console; None when nothing was."""
-        if not any(self.cropped) and not any(self.padded):
+        if not any(self.cropped) and not any(self.padded) and not self.yaw:
             return None
         rows, cols = source.occupied.shape
         width, height = self.extent
@@ -65,8 +107,9 @@ class FittedMap:
                 f"padded with unknown to whole cells of {self.factor * self.resolution:g} "
                 f"({self.padded[0]} columns right, {self.padded[1]} rows at the top)"
             )
+        turned = f", its x axis at yaw {self.yaw:g} rad" if self.yaw else ""
         parts.append(
-            f"domain {width:g} × {height:g}, its lower-left corner at ({self.corner[0]:g}, {self.corner[1]:g}) in the map's frame"
+            f"domain {width:g} × {height:g}, its lower-left corner at ({self.corner[0]:g}, {self.corner[1]:g}) in the map's frame{turned}"
         )
         return "; ".join(parts)
 
@@ -100,10 +143,11 @@ def fit_to_cells(occupancy_map: OccupancyMap, cell: float) -> FittedMap:
     kept = occupied[bottom:top, left:right]
     pad_rows, pad_cols = -kept.shape[0] % factor, -kept.shape[1] % factor
     fitted = np.pad(kept, ((0, pad_rows), (0, pad_cols)), constant_values=True)
-    corner = (
-        float(occupancy_map.origin[0] + int(left) * occupancy_map.resolution),
-        float(occupancy_map.origin[1] + int(bottom) * occupancy_map.resolution),
+    # The origin's yaw turns the image about its lower-left corner, the cropped pixels with it.
+    corner = MapFrame(occupancy_map.origin, occupancy_map.yaw).to_map(
+        int(left) * occupancy_map.resolution, int(bottom) * occupancy_map.resolution
     )
+    corner = (float(corner[0]), float(corner[1]))
     return FittedMap(
         fitted,
         occupancy_map.resolution,
@@ -111,4 +155,5 @@ def fit_to_cells(occupancy_map: OccupancyMap, cell: float) -> FittedMap:
         corner,
         (int(left), int(cols - right), int(bottom), int(rows - top)),
         (int(pad_cols), int(pad_rows)),
+        occupancy_map.yaw,
     )

@@ -15,7 +15,8 @@
   mission to given points; the deadlock cases of the tests use it).
 
 With a ``map`` both are in the map's own frame (what RViz shows; :mod:`model.scenario.map_fit`), as
-trajectory.csv is: the model subtracts the fitted map's corner (:func:`model.world.world.map_corner_of`).
+trajectory.csv is: the model takes them out of it (:class:`model.scenario.map_fit.MapFrame`: the fitted map's
+corner and the origin's yaw).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import math
 from typing import Any
 
 from model.scenario.map_file import load_map
-from model.scenario.map_fit import fit_to_cells
+from model.scenario.map_fit import MapFrame, fit_to_cells
 
 SAFETY_DEFAULTS: dict[str, Any] = {
     "safety": True,
@@ -94,11 +95,14 @@ def least_safety_range(
 
 def check_safety(scenario: Any) -> None:
     """The checks that need the whole scenario (agents, domain, gains); raises SafetyKeyError."""
-    corner = (0.0, 0.0)
+    frame = MapFrame()
     if scenario.map and (scenario.initial_poses or scenario.objectives):
-        corner = fit_to_cells(load_map(scenario.map), scenario.cell).corner  # the poses are in the map's frame
-    low_x, low_y = corner
-    high_x, high_y = corner[0] + scenario.domain[0], corner[1] + scenario.domain[1]
+        frame = fit_to_cells(load_map(scenario.map), scenario.cell).frame  # the poses are in the map's frame
+    width, height = scenario.domain
+    (low_x, low_y), (high_x, high_y) = frame.corner, frame.to_map(width, height)
+    where = f"[{low_x:g}, {high_x:g}] x [{low_y:g}, {high_y:g}]"
+    if frame.yaw:
+        where = f"{width:g} x {height:g} from ({low_x:g}, {low_y:g}), turned {frame.yaw:g} rad"
     for key in ("initial_poses", "objectives"):
         points = getattr(scenario, key)
         if points and len(points) != scenario.agents:
@@ -106,11 +110,11 @@ def check_safety(scenario: Any) -> None:
                 f"scenario key '{key}': expected {scenario.agents} entries (one per robot), got {len(points)}"
             )
         for index, point in enumerate(points):
-            if not (low_x <= point[0] <= high_x and low_y <= point[1] <= high_y):
-                frame = " (in the map's frame)" if scenario.map else ""
+            model_x, model_y = frame.from_map(point[0], point[1])
+            if not (0.0 <= model_x <= width and 0.0 <= model_y <= height):
+                in_map = " (in the map's frame)" if scenario.map else ""
                 raise SafetyKeyError(
-                    f"scenario key '{key}': entry {index} {list(point[:2])} lies outside the domain{frame} "
-                    f"[{low_x:g}, {high_x:g}] x [{low_y:g}, {high_y:g}]"
+                    f"scenario key '{key}': entry {index} {list(point[:2])} lies outside the domain{in_map} {where}"
                 )
     if not scenario.filters:
         return

@@ -2,7 +2,7 @@
 
 A map is the ROS map_server / Nav2 format: a YAML file naming an image (PGM or PNG), its
 ``resolution`` (domain units per pixel), ``origin`` [x, y, yaw] (the pose of the image's lower-left
-pixel; yaw 0 only), ``negate``, ``occupied_thresh`` and ``free_thresh``. A pixel's occupancy is
+pixel in the map's frame: the image's x axis lies at ``yaw``), ``negate``, ``occupied_thresh`` and ``free_thresh``. A pixel's occupancy is
 p = (255 − value) / 255 (p = value / 255 with ``negate``); it is occupied when p > occupied_thresh,
 free when p < free_thresh, and unknown in between, which counts as occupied (not free). Image row 0
 is the top of the map; grid row 0 is the bottom (y grows with the row, as everywhere in the model).
@@ -46,6 +46,7 @@ class OccupancyMap:
     path: Path
     sha256: str  # of the YAML file and of the image, so either changing shows
     known: np.ndarray | None = None  # bool like ``occupied``: occupied or free (not unknown); None: every pixel
+    yaw: float = 0.0  # radians: the image's x axis in the map's frame (origin's third value)
 
     @property
     def extent(self) -> tuple[float, float]:
@@ -89,13 +90,11 @@ def _read_yaml(path: Path) -> dict[str, Any]:
     return values
 
 
-def _origin(path: Path, value: Any) -> tuple[float, float]:
+def _origin(path: Path, value: Any) -> tuple[float, float, float]:
     if not isinstance(value, list) or len(value) != 3:
         raise TerrainError(f"map {path}: key 'origin': expected [x, y, yaw], got {value!r}")
     x, y, yaw = (_map_number(path, {"origin": item}, "origin", -math.inf, math.inf) for item in value)
-    if yaw != 0.0:
-        raise TerrainError(f"map {path}: key 'origin': a rotated map (yaw {yaw}) is not supported; yaw must be 0")
-    return x, y
+    return x, y, yaw
 
 
 def load_occupancy_map(path: str | Path) -> OccupancyMap:
@@ -110,7 +109,7 @@ def load_occupancy_map(path: str | Path) -> OccupancyMap:
     negate = values["negate"]
     if negate not in (0, 1, True, False):
         raise TerrainError(f"map {path}: key 'negate': expected 0 or 1, got {negate!r}")
-    origin = _origin(path, values["origin"])
+    x, y, yaw = _origin(path, values["origin"])
     image_path = path.parent / str(values["image"])
     if not image_path.is_file():
         raise TerrainError(f"map {path}: its image {image_path} does not exist")
@@ -122,7 +121,7 @@ def load_occupancy_map(path: str | Path) -> OccupancyMap:
     # Unknown (between the thresholds) is not free: a robot must not plan through it.
     occupied = np.flipud(~free).copy()
     known = np.flipud(free | (occupancy > occupied_thresh)).copy()
-    return OccupancyMap(occupied, resolution, origin, path, file_sha256(path, image_path), known)
+    return OccupancyMap(occupied, resolution, (x, y), path, file_sha256(path, image_path), known, yaw)
 
 
 def coarsen(occupied: np.ndarray, factor: int) -> np.ndarray:

@@ -38,7 +38,7 @@ from scipy.sparse.csgraph import connected_components
 from model.paper.fixed_point import COVERAGE_SCALE
 from model.scenario import Scenario
 from model.scenario.map_file import load_map
-from model.scenario.map_fit import FittedMap, fit_to_cells
+from model.scenario.map_fit import FittedMap, MapFrame, fit_to_cells
 from model.scenario.terrain import (
     OccupancyMap,
     TerrainError,
@@ -143,9 +143,13 @@ class World:
             report["map_sha256"] = self.map_sha256
         if self.priority_sha256:
             report["priority_sha256"] = self.priority_sha256
-        corner = map_corner_of(self.scenario)
-        if corner != (0.0, 0.0):
-            report["map_corner"] = list(corner)  # trajectory.csv is in the map's frame: the model's (0, 0) is here
+        frame = map_frame_of(self.scenario)
+        if frame.corner != (0.0, 0.0):
+            report["map_corner"] = list(
+                frame.corner
+            )  # trajectory.csv is in the map's frame: the model's (0, 0) is here
+        if frame.yaw != 0.0:
+            report["map_yaw"] = frame.yaw  # and the model's x axis at this angle
         return report
 
 
@@ -202,9 +206,10 @@ def fitted_map_of(scenario: Scenario) -> tuple[OccupancyMap, FittedMap]:
     return occupancy_map, fit_to_cells(occupancy_map, scenario.cell)
 
 
-def map_corner_of(scenario: Scenario) -> tuple[float, float]:
-    """Where the model's (0, 0) lies in the map's own frame (REP 105's ``map``); (0, 0) without a map."""
-    return fitted_map_of(scenario)[1].corner if scenario.map else (0.0, 0.0)
+def map_frame_of(scenario: Scenario) -> MapFrame:
+    """Where the model's frame lies in the map's own (REP 105's ``map``): its (0, 0) and x axis; the model's
+    own frame without a map."""
+    return fitted_map_of(scenario)[1].frame if scenario.map else MapFrame()
 
 
 def map_note_of(scenario: Scenario) -> str | None:
