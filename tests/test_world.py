@@ -9,7 +9,7 @@ import pytest
 from model.paper.fixed_point import COVERAGE_SCALE
 from model.parameters import coverage_map_of, starting_poses
 from model.scenario import Scenario, load_scenario, validate
-from model.world.world import team_space, world_of
+from model.world.world import closed_gaps, team_space, world_of
 from tests.conftest import ROOT
 
 # Four walls 1 unit thick closing a 6 x 6 room whose inside spans [12, 18] x [12, 18].
@@ -183,3 +183,19 @@ def test_walls_drawn_on_whole_cells_keep_the_world_fitted_to_cells(tmp_path):
     )
     world = world_of(validate({"map": "block.yaml", "cell": 0.5, "robot_radius": 0.2}, tmp_path))
     assert world.grain == 0.5 and world.wall_grid is world.wall_grid and world.wall_grid.shape == world.occupied.shape
+
+
+def test_gaps_narrower_than_a_tenth_of_a_unit_are_filled_and_nothing_else():
+    wall = np.zeros((7, 14), dtype=bool)
+    wall[3, :12] = True  # a wall that stops two pixels short of the image's right edge
+    wall[3, 3] = False  # a gap of one pixel
+    wall[3, 6:8] = False  # a gap of two
+    closed = {resolution: closed_gaps(wall, resolution) for resolution in (1.0, 0.05, 0.04)}
+    assert closed[1.0][3, 3] and closed[0.05][3, 3]  # one pixel: always a gap
+    assert not closed[0.05][3, 6:8].any() and closed[0.04][3, 6:8].all()  # 0.1 wide at 0.05; 0.08 at 0.04
+    for image in closed.values():
+        assert not image[3, 12:].any()  # a run to the image's edge has no wall at one end
+        assert (image[[0, 1, 2, 4, 5, 6]] == wall[[0, 1, 2, 4, 5, 6]]).all()  # nothing else changes
+    pocket = np.ones((10, 10), dtype=bool)
+    pocket[4:6, 4:6] = False  # a free square two pixels wide, walls all round: a room at 1 unit a pixel
+    assert (closed_gaps(pocket, 1.0) == pocket).all()
