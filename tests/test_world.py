@@ -114,7 +114,7 @@ def two_rooms_map(folder, crack: bool = True, resolution: float = 0.08):
     image[[0, -1], :] = 0
     image[:, [0, -1]] = 0
     image[:, 99] = 0  # the wall between the west and east rooms: cell column 9
-    image[40:62, 99] = 254  # its door: y from 3.04 to 4.8 m
+    image[44:66, 99] = 254  # its door: y from 2.72 to 4.48 m
     image[40, 150:] = 0  # the closed room's south wall (cell row 5) and west wall (cell column 15)
     image[:40, 150] = 0
     image = image[::scale, ::scale].copy()  # (at 0.16 m every wall drawn above keeps one pixel)
@@ -152,9 +152,9 @@ def test_walls_kept_to_the_map_s_pixel_let_a_robot_through_a_door_that_whole_cel
     assert fine.grain == pytest.approx(0.16) and coarse.grain == 0.8
     assert (fine.occupied == coarse.occupied).all()  # what there is to cover is the same
     west, east = np.s_[:, :9], np.s_[:5, 10:]
-    # On whole cells the door's jambs are cells of wall: the 1.76 m door is 1.6 m of free cells, too little for
-    # a robot 0.88 m wide with its margins between cell centres 0.8 apart. To the pixel the centre at y = 3.6
-    # is 0.56 m off the jamb.
+    # On whole cells the door's jambs are cells of wall: the 1.76 m door is one row of free cells, its centre
+    # 0.4 m from them, too little for r + s and the planning margin (0.44 m). To the pixel that centre is
+    # 0.88 m off each jamb, enough for that and half a cell more (0.84 m: world.FINE_WALL_MARGIN).
     assert fine.reachable[west].any() and fine.reachable[east].any()
     assert coarse.reachable[west].any() != coarse.reachable[east].any()
     assert fine.coverable[west].all() == (~fine.occupied[west]).all() and fine.coverable[east].sum() > 0

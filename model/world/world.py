@@ -84,7 +84,7 @@ class World:
             self.occupied,
             self.passable,
             scenario.robot_radius,
-            plan_radius_of(scenario),
+            plan_radius_of(scenario, self.grain < scenario.cell),
             wall_clearance_of(scenario),
             bool(scenario.map),
             walls,
@@ -164,11 +164,22 @@ def viewing_range_of(scenario: Scenario) -> float:
     return max(scenario.range - scenario.cell, 0.5 * scenario.range)
 
 
-def plan_radius_of(scenario: Scenario) -> float:
+FINE_WALL_MARGIN = 0.5
+"""Clearance, in cells, that paths and straight drives keep beyond the planning margin where walls are finer
+than the cell (:func:`plan_radius_of`): half a cell, how far from a cell's centre a robot sent there stops
+(model.world.wall_law). On whole cells a passable centre's disk is clear of whole wall cells, and the real
+wall lies up to a cell beyond; to the pixel, a centre that only just held the disk put robots among the
+campus map's outdoor speckle, where the law and the filter dithered between the specks: 6 of 30 single
+robots completed (issue 34, 2026-12-06). With this margin seeds 0 - 3 completed, all four (a quarter cell:
+three)."""
+
+
+def plan_radius_of(scenario: Scenario, fine_walls: bool = False) -> float:
     """The robot's radius plus the planning margin: what passable cells and straight drives keep free.
     With the safety filter on, its margin too: the filter keeps the disk s off every wall (model.safety.safety),
-    so a path nearer a wall than that would be one the filter stops the robot on."""
-    return wall_clearance_of(scenario) + PLANNING_MARGIN * scenario.cell
+    so a path nearer a wall than that would be one the filter stops the robot on. With walls finer than the
+    cell (``fine_walls``), FINE_WALL_MARGIN more."""
+    return wall_clearance_of(scenario) + (PLANNING_MARGIN + (FINE_WALL_MARGIN if fine_walls else 0.0)) * scenario.cell
 
 
 def wall_clearance_of(scenario: Scenario) -> float:
@@ -310,8 +321,9 @@ def world_of(scenario: Scenario) -> World:
     if occupied.all():
         raise TerrainError(f"{where} has no free cell")
     bounded = bool(scenario.map)
-    passable = passable_cells(wall_grid, plan_radius_of(scenario), cell, bounded, grain, shape)
-    graph = passage_graph(passable, cell, wall_grid, grain, plan_radius_of(scenario), bounded).tocsr()
+    plan_radius = plan_radius_of(scenario, split > 1)
+    passable = passable_cells(wall_grid, plan_radius, cell, bounded, grain, shape)
+    graph = passage_graph(passable, cell, wall_grid, grain, plan_radius, bounded).tocsr()
     reachable = team_space(passable, cell, graph)
     if not reachable.any():
         raise TerrainError(f"{where}: no free place holds a robot of radius {scenario.robot_radius}")
