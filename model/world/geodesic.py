@@ -103,10 +103,8 @@ def _drivable(
 ) -> np.ndarray:
     keep = np.zeros(sources.shape[0], dtype=np.bool_)
     for k in range(sources.shape[0]):
-        low, high = (
-            min(sources[k], targets[k]),
-            max(sources[k], targets[k]),
-        )  # each way alike: the graph stays symmetric
+        # Each way alike, from the lower node: the graph stays symmetric.
+        low, high = min(sources[k], targets[k]), max(sources[k], targets[k])
         x0, y0 = (low % cols + 0.5) * cell, (low // cols + 0.5) * cell
         x1, y1 = (high % cols + 0.5) * cell, (high // cols + 0.5) * cell
         keep[k] = swept_disk_is_free(wall_grid, x0, y0, x1, y1, radius, grain, bounded)

@@ -1,12 +1,13 @@
 """The world a team covers, built once per scenario: walls, where a robot can go, what it can see.
 
-- ``wall_grid``: the walls as bodies and cameras meet them, on squares of ``grain`` (:func:`grain_of`: the cell, or a
-  whole fraction of it where the map has walls finer than a cell): the map fitted to the coverage grid
+- ``wall_grid``: the walls as bodies and cameras meet them, on squares of ``grain`` (:func:`grain_split_of`: the cell,
+  or a whole fraction of it where the map has walls finer than a cell; gaps filled by :func:`closed_gaps`): the map fitted to the coverage grid
   (:mod:`model.scenario.map_fit`: its unknown border cropped, padded to whole cells) or'd with the polygons
   (:func:`model.scenario.terrain.polygons_on_grid`). Every disk test (a robot's body, a straight drive, the
   safety filter's walls) and every line of sight reads it.
 - ``occupied``: the coverage cells with a wall square in them: nothing there to cover.
-- ``passable``: coverage-cell centres that hold the robot's disk with PLANNING_MARGIN to spare, clear of the
+- ``passable``: coverage-cell centres that hold the robot's disk with PLANNING_MARGIN to spare (and
+  FINE_WALL_MARGIN where the wall squares are finer than the cell: :func:`plan_radius_of`), clear of the
   wall squares (:func:`model.world.geodesic.passable_cells`); two neighbours are joined when the disk drives
   straight from one centre to the other (:func:`model.world.geodesic.passage_graph`).
 - ``graph``: that graph (CSR; None in the open world), for the distance fields.
@@ -145,12 +146,11 @@ class World:
         if self.priority_sha256:
             report["priority_sha256"] = self.priority_sha256
         frame = map_frame_of(self.scenario)
+        # trajectory.csv is in the map's frame: the model's (0, 0) is at map_corner, its x axis at map_yaw.
         if frame.corner != (0.0, 0.0):
-            report["map_corner"] = list(
-                frame.corner
-            )  # trajectory.csv is in the map's frame: the model's (0, 0) is here
+            report["map_corner"] = list(frame.corner)
         if frame.yaw != 0.0:
-            report["map_yaw"] = frame.yaw  # and the model's x axis at this angle
+            report["map_yaw"] = frame.yaw
         return report
 
 
@@ -170,8 +170,8 @@ than the cell (:func:`plan_radius_of`): half a cell, how far from a cell's centr
 (model.world.wall_law). On whole cells a passable centre's disk is clear of whole wall cells, and the real
 wall lies up to a cell beyond; to the pixel, a centre that only just held the disk put robots among the
 campus map's outdoor speckle, where the law and the filter dithered between the specks: 6 of 30 single
-robots completed (issue 34, 2026-12-06). With this margin seeds 0 - 3 completed, all four (a quarter cell:
-three)."""
+robots completed (issue 34, 2026-12-06). Seeds 0 - 3 with 0.45 of a cell: all four; with a quarter: three.
+The study with half a cell (docs/real-maps.md): 26 of 30 single robots, every team of 4 and 8."""
 
 
 def plan_radius_of(scenario: Scenario, fine_walls: bool = False) -> float:
