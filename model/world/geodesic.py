@@ -40,8 +40,8 @@ def passable_cells(
 ) -> np.ndarray:
     """Coverage cells (``shape``, side ``cell``) whose centre can hold the robot's disk among the wall squares
     (side ``grain``); by default the wall squares are the cells themselves."""
-    grain, shape = (cell, wall_grid.shape) if grain is None or shape is None else (grain, shape)
-    return _passable_centres(wall_grid, radius, cell, bounded, grain, shape[0], shape[1])
+    rows, cols = wall_grid.shape if shape is None else shape
+    return _passable_centres(wall_grid, radius, cell, bounded, cell if grain is None else grain, rows, cols)
 
 
 @njit(cache=True)
