@@ -33,8 +33,10 @@ ReasonFunction = Callable[[int, tuple[float, float], tuple[float, float], float]
 """(agent, position, objective, path since the last progress) → why the robot made no progress, in words."""
 
 
-def _rounded(point: tuple[float, float]) -> list[float]:
-    return [round(float(point[0]), 4), round(float(point[1]), 4)]
+def rounded(point: tuple[float, float]) -> list[float]:
+    """A point for summary.json, to 0.1 mm (rounded as its own number type rounds: the same as before the
+    map frame could turn)."""
+    return [round(point[0], 4), round(point[1], 4)]
 
 
 @dataclass(frozen=True)
@@ -51,8 +53,8 @@ class RobotStall:
         """For summary.json: positions in the map's frame."""
         return {
             "agent": self.agent,
-            "position": _rounded(frame.to_map(*self.position)),
-            "objective": _rounded(frame.to_map(*self.objective)),
+            "position": rounded(frame.to_map(*self.position)),
+            "objective": rounded(frame.to_map(*self.objective)),
             "moved": round(self.moved, 4),
             "reason": self.reason,
         }
@@ -72,7 +74,7 @@ class Stall:
             "time": round(self.time, 6),
             "action": self.action,
             "cells": len(self.cells),
-            "cell_centres": [_rounded(frame.to_map((col + 0.5) * cell, (row + 0.5) * cell)) for row, col in self.cells],
+            "cell_centres": [rounded(frame.to_map((col + 0.5) * cell, (row + 0.5) * cell)) for row, col in self.cells],
             "robots": [robot.as_dict(frame) for robot in self.robots],
         }
 

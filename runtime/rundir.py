@@ -19,6 +19,7 @@ from model.planning import default_patience
 from model.run import RunResult
 from model.safety.safety_record import safety_figures
 from model.scenario.map_fit import MapFrame
+from model.watchdog import rounded
 from model.world.world import World, map_frame_of, world_of
 
 TRAJECTORY_HEADER = "t,agent,x,y,theta,v,omega"
@@ -92,7 +93,7 @@ def watchdog_report(result: RunResult, world: World) -> dict[str, Any]:
     left = (result.final_lack > 0.0) & world.coverable
     given_up = result.given_up if result.given_up is not None else np.zeros_like(left)
     centres = [
-        [round(float(v), 4) for v in frame.to_map((col + 0.5) * scenario.cell, (row + 0.5) * scenario.cell)]
+        rounded(frame.to_map((col + 0.5) * scenario.cell, (row + 0.5) * scenario.cell))
         for row, col in np.argwhere(left)
     ]
     why = "completed" if result.completed else (

@@ -60,11 +60,16 @@ class MapFrame:
 
     def heading_to_map(self, theta: Any) -> Any:
         """A model heading in the map's frame, in (−π, π] when turned."""
-        return theta if self.yaw == 0.0 else np.remainder(theta + self.yaw + math.pi, 2.0 * math.pi) - math.pi
+        return theta if self.yaw == 0.0 else _wrapped(theta + self.yaw)
 
     def heading_from_map(self, theta: Any) -> Any:
-        """A map-frame heading in the model's frame."""
-        return theta if self.yaw == 0.0 else np.remainder(theta - self.yaw + math.pi, 2.0 * math.pi) - math.pi
+        """A map-frame heading in the model's frame, in (−π, π] when turned."""
+        return theta if self.yaw == 0.0 else _wrapped(theta - self.yaw)
+
+
+def _wrapped(angle: Any) -> Any:
+    """model.paper.geometry.wrap_angle's (−π, π], for arrays too."""
+    return angle - 2.0 * math.pi * np.ceil((angle - math.pi) / (2.0 * math.pi))
 
 
 @dataclass(frozen=True)

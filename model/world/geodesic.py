@@ -103,12 +103,20 @@ def _drivable(
 ) -> np.ndarray:
     keep = np.zeros(sources.shape[0], dtype=np.bool_)
     for k in range(sources.shape[0]):
-        # Each way alike, from the lower node: the graph stays symmetric.
-        low, high = min(sources[k], targets[k]), max(sources[k], targets[k])
-        x0, y0 = (low % cols + 0.5) * cell, (low // cols + 0.5) * cell
-        x1, y1 = (high % cols + 0.5) * cell, (high // cols + 0.5) * cell
-        keep[k] = swept_disk_is_free(wall_grid, x0, y0, x1, y1, radius, grain, bounded)
+        keep[k] = drivable_step(wall_grid, grain, cell, cols, sources[k], targets[k], radius, bounded)
     return keep
+
+
+@njit(cache=True)
+def drivable_step(
+    wall_grid: np.ndarray, grain: float, cell: float, cols: int, node: int, other: int, radius: float, bounded: bool
+) -> bool:
+    """Whether the disk drives straight between the centres of two cells (nodes row·cols + col) among the wall
+    squares: a step of :func:`passage_graph`. Swept from the lower node, so each way gives the same answer."""
+    low, high = min(node, other), max(node, other)
+    x0, y0 = (low % cols + 0.5) * cell, (low // cols + 0.5) * cell
+    x1, y1 = (high % cols + 0.5) * cell, (high // cols + 0.5) * cell
+    return swept_disk_is_free(wall_grid, x0, y0, x1, y1, radius, grain, bounded)
 
 
 def distance_fields(
@@ -184,6 +192,7 @@ def descent_waypoint(
     distance = field[row, col] + math.hypot(waypoint_x - x, waypoint_y - y)  # as length_by_field measures it
     walk = np.empty((lookahead, 2), dtype=np.int64)
     steps = 0
+    fine = wall_grid.shape[0] != rows  # wall squares finer than the cells: the graph may lack a step
     for _ in range(lookahead):
         best_row, best_col, best = row, col, field[row, col]
         for k in range(8):
@@ -194,6 +203,10 @@ def descent_waypoint(
                 continue
             if d_row != 0 and d_col != 0 and not (passable[r, col] and passable[row, c]):
                 continue  # the graph's rule: no cutting a corner
+            if fine and not drivable_step(
+                wall_grid, grain, cell, cols, row * cols + col, r * cols + c, radius, bounded
+            ):
+                continue  # nor a step passage_graph left out (a thin wall between two passable centres)
             best_row, best_col, best = r, c, field[r, c]
         if best_row == row and best_col == col:
             break  # the goal cell

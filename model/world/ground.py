@@ -20,14 +20,14 @@ class Ground(NamedTuple):
     occupied: np.ndarray  # bool (rows, cols): coverage cells with a wall in them (nothing there to cover)
     passable: np.ndarray  # bool (rows, cols): centres that hold the robot's disk
     radius: float  # r
-    plan_radius: float  # wall_clearance plus PLANNING_MARGIN: what paths and straight drives are planned with
+    plan_radius: float  # wall_clearance plus PLANNING_MARGIN (and world.FINE_WALL_MARGIN on fine walls): what paths and drives keep
     wall_clearance: float  # r, plus the safety margin s when the filter is on: what the law keeps off walls
     bounded: bool  # the map's edge is a wall
     walls: bool  # an occupied cell: the global law and the assignment go round them
     occlusion: bool  # lines of sight are tested (walls, or teammates' disks when r > 0)
     lookahead: int  # cells walked down a distance field for the global law's waypoint
     wall_grid: np.ndarray  # bool (rows·k, cols·k): the walls as bodies and cameras meet them, squares of ``grain``
-    grain: float  # side of a wall_grid square: the cell, or a whole fraction of it (model.world.world.grain_of)
+    grain: float  # side of a wall_grid square: the cell, or a whole fraction of it (model.world.world.grain_split_of)
 
 
 def open_ground() -> Ground:

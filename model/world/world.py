@@ -234,7 +234,7 @@ def map_note_of(scenario: Scenario) -> str | None:
 
 MAX_GRAIN_SPLIT = 5
 """At most this many wall squares a cell side (25 a cell). A map's walls are kept to its pixel where that
-fits, else to the largest whole number of pixels that divides the cell into at most this many: 0.05 m on
+fits, else to the largest whole number of pixels that divides the cell into at most this many: 0.04 m on
 the lab map's 0.2 m cells, 0.16 m on the campus's 0.8 m. Fitted to whole cells instead, a one-pixel wall
 thickened to a cell on each side it touched: on the campus, doors and corridors under about 3.8 m closed,
 and 4,735 free cells (3,030 m², 42 % of the free space) counted as unreachable (issue 34). Finer costs
