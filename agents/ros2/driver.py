@@ -53,8 +53,9 @@ ODOMETRY_HISTORY = 256
 
 
 def frame_of(scenario: Scenario, options: Ros2Options) -> ScenarioFrame:
-    """The scenario in the robot's map frame: its (0, 0) at ``origin`` if given, else where the scenario's map
-    puts it, turned by the map's yaw (the same Nav2 map: the frames then agree; :func:`model.world.world.map_frame_of`,
+    """The scenario in the robot's map frame: its (0, 0) at ``origin`` if given (its axes the map frame's: a
+    given origin places the scenario unturned, whatever its map's yaw), else where the scenario's map puts it,
+    turned by the map's yaw (the same Nav2 map: the frames then agree; :func:`model.world.world.map_frame_of`,
     the map's origin when no unknown border was cropped), else at the map frame's (0, 0); its units."""
     if options.origin is not None:
         return ScenarioFrame(options.origin, scenario.metres_per_unit, scenario.seconds_per_unit)
