@@ -2,8 +2,16 @@
 
 One :class:`RunRecorder` serves both the logger process (live, message by
 message) and ``anicov run`` (after the run, from its result), so a recording
-looks the same however the run was made. Entity tree, in the map view's cell
-units with y pointing up (x/cell, rows − y/cell):
+looks the same however the run was made.
+
+**Frames.** Every point is logged in the map's own frame (what a user reads off
+RViz; the model's frame without a map): poses, wedges, trails, objectives and
+blobs in map units, as trajectory.csv has them. Images keep their pixels, and
+a static transform on ``world/map`` and ``world/blobs/segmentation`` places
+them in that frame, turned with the map's yaw. The view's y axis points down,
+so each of ``world/domain``, ``world/agents`` and ``world/blobs/objectives``
+carries a static y flip: the map is drawn with y up, and a hovered point
+shows its map-frame value. Entity tree:
 
     world/domain                       LineStrips2D   the domain outline
     world/map/lack_of_coverage         Image (f32)    Υ (eq. 4): white = uncovered, black = covered
@@ -46,12 +54,30 @@ from model.paper.fixed_point import COVERAGE_SCALE
 from model.safety.safety import DEADLOCK_FOUND, DEADLOCK_RESOLVED
 from model.safety.safety_record import ACTIVE as FILTER_ACTIVE
 from model.scenario import Scenario
+from model.scenario.map_fit import MapFrame
 from model.world.world import map_frame_of, world_of
 
 APPLICATION_ID = "anicov"
 TRAIL_STEPS = 500
 """Steps of path shown behind each agent (subsampled at the map decimation)."""
 WEDGE_ARC_POINTS = 9
+HEADING_ARROW = 0.5
+"""The heading arrow's length, in camera ranges R."""
+Y_UP = rr.Transform3D(mat3x3=np.diag([1.0, -1.0, 1.0]))
+"""The view's y axis points down; this draws a map-frame point with y up."""
+
+
+def pixels_to_view(frame: MapFrame, rows: int, cell: float) -> rr.Transform3D:
+    """Where a map view image (a grid of ``rows`` rows of ``cell``, flipped so that row 0 is the top) lies:
+    pixel (u, v) is the model's point (u·cell, (rows − v)·cell), placed in the map's frame by ``frame`` and
+    flipped to the view's y down, as :data:`Y_UP` flips the points."""
+    cos_yaw, sin_yaw = np.cos(frame.yaw), np.sin(frame.yaw)
+    turn = np.array([[cos_yaw, -sin_yaw], [sin_yaw, cos_yaw]])
+    linear = np.diag([1.0, -1.0]) @ turn @ np.diag([cell, -cell])
+    top_left = np.array(frame.corner) + turn @ np.array([0.0, rows * cell])
+    matrix = np.eye(3)
+    matrix[:2, :2] = linear
+    return rr.Transform3D(translation=[top_left[0], -top_left[1], 0.0], mat3x3=matrix)
 
 
 def default_blueprint(agents: int) -> rrb.Blueprint:
@@ -89,6 +115,7 @@ class RunRecorder:
     ) -> None:
         self.scenario = scenario
         self.rows, self.cols = scenario.grid_shape
+        self.frame = map_frame_of(scenario)
         self.map_every = max(1, map_every)
         self.stream = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id, send_properties=False)
         sinks: list = []
@@ -118,9 +145,9 @@ class RunRecorder:
 
     # -------------------------------------------------------------- helpers
 
-    def to_view(self, x: np.ndarray | float, y: np.ndarray | float) -> np.ndarray:
-        """World (x, y) → map view coordinates (cells, y up)."""
-        return np.stack([np.asarray(x) / self.scenario.cell, self.rows - np.asarray(y) / self.scenario.cell], axis=-1)
+    def to_map(self, x: np.ndarray | float, y: np.ndarray | float) -> np.ndarray:
+        """Model (x, y) → the map's frame, as points (…, 2)."""
+        return np.stack(self.frame.to_map(np.asarray(x, dtype=float), np.asarray(y, dtype=float)), axis=-1)
 
     def _at(self, step: int) -> None:
         self.stream.set_time("step", sequence=step)
@@ -128,7 +155,12 @@ class RunRecorder:
 
     def _log_static(self) -> None:
         width, height = self.scenario.domain
-        corners = self.to_view(np.array([0, width, width, 0, 0]), np.array([0, 0, height, height, 0]))
+        for entity in ("world/domain", "world/agents", "world/blobs/objectives"):
+            self.stream.log(entity, Y_UP, static=True)
+        images = pixels_to_view(self.frame, self.rows, self.scenario.cell)
+        for entity in ("world/map", "world/blobs/segmentation"):
+            self.stream.log(entity, images, static=True)
+        corners = self.to_map(np.array([0, width, width, 0, 0]), np.array([0, 0, height, height, 0]))
         self.stream.log("world/domain", rr.LineStrips2D([corners], colors=[(80, 80, 255)]), static=True)
         self._log_terrain()
         lines = [f"- **{key}**: {value}" for key, value in self.scenario.to_dict().items()]
@@ -161,7 +193,7 @@ class RunRecorder:
         angles = np.linspace(theta - self.scenario.half_angle, theta + self.scenario.half_angle, WEDGE_ARC_POINTS)
         xs = np.concatenate([[x], x + self.scenario.range * np.cos(angles), [x]])
         ys = np.concatenate([[y], y + self.scenario.range * np.sin(angles), [y]])
-        return self.to_view(xs, ys)
+        return self.to_map(xs, ys)
 
     # -------------------------------------------------------------- logging
 
@@ -193,7 +225,7 @@ class RunRecorder:
             self._at(step)
             trail = np.array(self._trails[agent])
             self.stream.log(f"world/agents/{agent}/wedge", rr.LineStrips2D([self.wedge(x, y, theta)]))
-            self.stream.log(f"world/agents/{agent}/trail", rr.LineStrips2D([self.to_view(trail[:, 0], trail[:, 1])]))
+            self.stream.log(f"world/agents/{agent}/trail", rr.LineStrips2D([self.to_map(trail[:, 0], trail[:, 1])]))
 
     def flush_states(self) -> None:
         """Send the buffered per-step poses and series as columns."""
@@ -206,41 +238,42 @@ class RunRecorder:
                 rr.TimeColumn("step", sequence=steps),
                 rr.TimeColumn("sim_time", duration=steps * self.scenario.dt),
             ]
-            view = self.to_view(data[:, 1], data[:, 2])
+            points = self.to_map(data[:, 1], data[:, 2])
             label = f"agent {agent}"
             self.stream.send_columns(
                 f"world/agents/{agent}/position",
                 indexes=indexes,
-                columns=rr.Points2D.columns(positions=view, labels=[label] * len(steps)),
+                columns=rr.Points2D.columns(positions=points, labels=[label] * len(steps)),
             )
-            heading = np.stack([np.cos(data[:, 3]), -np.sin(data[:, 3])], axis=1) * 4.0 / self.scenario.cell
+            theta = self.frame.heading_to_map(data[:, 3])
+            heading = np.stack([np.cos(theta), np.sin(theta)], axis=1) * HEADING_ARROW * self.scenario.range
             self.stream.send_columns(
                 f"world/agents/{agent}/heading",
                 indexes=indexes,
-                columns=rr.Arrows2D.columns(origins=view, vectors=heading),
+                columns=rr.Arrows2D.columns(origins=points, vectors=heading),
             )
             for column, name in ((4, "v"), (5, "omega"), (6, "e_omega")):
                 self.stream.send_columns(
                     f"agents/{agent}/{name}", indexes=indexes, columns=rr.Scalars.columns(scalars=data[:, column])
                 )
             if self.scenario.robot_radius > 0.0:
-                self._send_bodies(agent, indexes, view, data[:, 7].astype(np.int64))
+                self._send_bodies(agent, indexes, points, data[:, 7].astype(np.int64))
         self._pending = {}
         if self._pending_errors:
             data = np.array(self._pending_errors)
             self.domain_errors(data[:, 1], data[:, 0].astype(np.int64))
             self._pending_errors = []
 
-    def _send_bodies(self, agent: int, indexes: list, view: np.ndarray, flags: np.ndarray) -> None:
+    def _send_bodies(self, agent: int, indexes: list, points: np.ndarray, flags: np.ndarray) -> None:
         """The robot's disk at every step, red while the safety filter acts; and the filter as a series."""
         active = (flags & FILTER_ACTIVE) != 0
-        half = self.scenario.robot_radius / self.scenario.cell
+        radius = self.scenario.robot_radius
         colors = np.where(active[:, None], np.array([[230, 40, 40, 255]]), np.array([[200, 200, 200, 255]]))
         self.stream.send_columns(
             f"world/agents/{agent}/body",
             indexes=indexes,
             columns=rr.Ellipses2D.columns(
-                centers=view, half_sizes=np.full((len(view), 2), half), colors=colors.astype(np.uint8)
+                centers=points, half_sizes=np.full((len(points), 2), radius), colors=colors.astype(np.uint8)
             ),
         )
         self.stream.send_columns(
@@ -300,13 +333,15 @@ class RunRecorder:
         if len(blobs):
             self.stream.log(
                 "world/blobs/objectives",
-                rr.Points2D(self.to_view(blobs[:, 0], blobs[:, 1]), radii=1.2, colors=[(255, 160, 0)]),
+                rr.Points2D(
+                    self.to_map(blobs[:, 0], blobs[:, 1]), radii=1.2 * self.scenario.cell, colors=[(255, 160, 0)]
+                ),
             )
         if labels is not None:
             self.stream.log("world/blobs/segmentation", rr.SegmentationImage(np.flipud(labels)))
         for agent, target in zip(members, targets, strict=True):
             if agent < len(positions) and not math.isnan(positions[agent][0]):
-                segment = self.to_view(
+                segment = self.to_map(
                     np.array([positions[agent][0], target[0]]), np.array([positions[agent][1], target[1]])
                 )
                 self.stream.log(f"world/agents/{agent}/objective", rr.LineStrips2D([segment], colors=[(255, 160, 0)]))

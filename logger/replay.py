@@ -21,11 +21,13 @@ _BUS = re.compile(r"^/bus/([a-z]+-\d+)/(bytes_in|bytes_out)$")
 class RecordingContent:
     recording_ids: list[str]
     entities: set[str] = field(default_factory=set)
+    timed: set[str] = field(default_factory=set)  # the entities logged on the step timeline (not only static)
     last_step: int = -1
     domain_error: dict[int, float] = field(default_factory=dict)  # step → e_D
-    positions: dict[int, dict[int, tuple[float, float]]] = field(default_factory=dict)  # agent → step → view (x, y)
+    positions: dict[int, dict[int, tuple[float, float]]] = field(default_factory=dict)  # agent → step → map (x, y)
     maps: dict[int, np.ndarray] = field(default_factory=dict)  # step → Υ as logged (view orientation)
     traffic: dict[tuple[str, str], list[float]] = field(default_factory=dict)  # (process, bytes_in|out) → B/s
+    transforms: dict[str, np.ndarray] = field(default_factory=dict)  # entity → its static 2D affine (3 × 3)
 
     @property
     def agents(self) -> list[int]:
@@ -46,8 +48,12 @@ def summarise_recording(path: Path, load_maps: bool = True) -> RecordingContent:
     for chunk in reader.stream():
         entity = str(chunk.entity_path)
         content.entities.add(entity)
-        if chunk.is_static or "step" not in chunk.timeline_names:
+        if chunk.is_static:
+            _read_transform(content, entity, chunk.to_record_batch())
             continue
+        if "step" not in chunk.timeline_names:
+            continue
+        content.timed.add(entity)
         batch = chunk.to_record_batch()
         steps = batch.column("step").to_numpy()
         if len(steps):
@@ -72,6 +78,22 @@ def summarise_recording(path: Path, load_maps: bool = True) -> RecordingContent:
                 data = np.frombuffer(bytes(buffer[0]), dtype=np.float32)
                 content.maps[int(step)] = data.reshape(fmt["height"], fmt["width"])
     return content
+
+
+def _read_transform(content: RecordingContent, entity: str, batch) -> None:
+    """A static Transform3D of the map view, as the 2D affine it is: view = A · (x, y, 1)."""
+    names = set(batch.schema.names)
+    if "Transform3D:mat3x3" not in names:
+        return
+    matrix = np.array(batch.column("Transform3D:mat3x3").to_pylist()[-1][0], dtype=float).reshape(3, 3, order="F")
+    translation = (
+        batch.column("Transform3D:translation").to_pylist()[-1] if "Transform3D:translation" in names else None
+    )
+    affine = np.eye(3)
+    affine[:2, :2] = matrix[:2, :2]
+    if translation:
+        affine[:2, 2] = np.array(translation[0], dtype=float)[:2]
+    content.transforms[entity] = affine
 
 
 def format_recording_summary(content: RecordingContent) -> str:

@@ -174,11 +174,9 @@ def test_initial_poses_and_objectives_are_read_in_the_maps_frame(tmp_path):
         load_scenario(tmp_path / "s.toml")
 
 
-def test_a_map_turned_by_its_origin_s_yaw_keeps_poses_in_its_own_frame(tmp_path):
-    """map_saver's origin [x, y, yaw]: the image's x axis lies at yaw in the map's frame. Poses given and written
-    are in that frame: the model's turned by the yaw about the fitted corner, which the crop moved along the
-    turned axes."""
-    yaw = 0.5
+def turned_scenario(tmp_path, yaw: float):
+    """The saved map with its origin at ``yaw``, a 40-unit run from a start to a goal given in the map's frame:
+    (scenario, the frame it should have, start, goal)."""
     (tmp_path / "flat").mkdir()
     unturned = fit_to_cells(load_occupancy_map(saved_map(tmp_path / "flat")[0]), 0.1)
     cropped_x, cropped_y = unturned.corner[0] - ORIGIN[0], unturned.corner[1] - ORIGIN[1]
@@ -194,7 +192,15 @@ def test_a_map_turned_by_its_origin_s_yaw_keeps_poses_in_its_own_frame(tmp_path)
     start, goal = turned.to_map(2.0, 2.0), turned.to_map(4.5, 2.0)  # in the room; heading along the image's x
     poses = f"initial_poses = [[{start[0]}, {start[1]}, {np.degrees(yaw)}]]\nobjectives = [[{goal[0]}, {goal[1]}]]\n"
     (tmp_path / "s.toml").write_text(text + poses)
-    scenario = load_scenario(tmp_path / "s.toml")
+    return load_scenario(tmp_path / "s.toml"), turned, start, goal
+
+
+def test_a_map_turned_by_its_origin_s_yaw_keeps_poses_in_its_own_frame(tmp_path):
+    """map_saver's origin [x, y, yaw]: the image's x axis lies at yaw in the map's frame. Poses given and written
+    are in that frame: the model's turned by the yaw about the fitted corner, which the crop moved along the
+    turned axes."""
+    yaw = 0.5
+    scenario, turned, start, goal = turned_scenario(tmp_path, yaw)
     assert map_frame_of(scenario).corner == pytest.approx(turned.corner) and map_frame_of(scenario).yaw == yaw
     assert "x axis at yaw 0.5 rad" in map_note_of(scenario)
     result = run_scenario(scenario)
@@ -208,3 +214,17 @@ def test_a_map_turned_by_its_origin_s_yaw_keeps_poses_in_its_own_frame(tmp_path)
     steps = len(result.trace)
     assert np.allclose(np.stack(turned.from_map(xs, ys), axis=1)[:steps], result.trace[:, 0, :2])
     assert min(np.hypot(xs - goal[0], ys - goal[1])) <= scenario.range / 2 + 0.05  # it drove to the goal given
+
+
+def test_obstacles_on_a_map_are_given_in_the_map_s_frame(tmp_path):
+    """A polygon on a map lies where the map's frame puts it (as poses do): a small square around a point of the
+    room, read off the map's frame, walls exactly the cells around that point in the model's frame, turned too."""
+    scenario, turned, _, _ = turned_scenario(tmp_path, yaw=0.5)
+    inside = [float(v) for v in turned.to_map(3.05, 2.05)]  # the centre of model cell (row 20, col 30): cell 0.1
+    square = [
+        [inside[0] + dx, inside[1] + dy] for dx, dy in ((-0.02, -0.02), (0.02, -0.02), (0.02, 0.02), (-0.02, 0.02))
+    ]
+    (tmp_path / "s.toml").write_text((tmp_path / "s.toml").read_text() + f"obstacles = [{square}]\n")
+    with_square = world_of(load_scenario(tmp_path / "s.toml"))
+    added = coarsen(with_square.wall_grid, round(scenario.cell / with_square.grain)) & ~world_of(scenario).occupied
+    assert [tuple(cell) for cell in np.argwhere(added)] == [(20, 30)]

@@ -51,16 +51,22 @@ def check_recording(recording: Path, trajectory: Path, final_lack: np.ndarray, a
     assert content.agents == list(range(agents))
     assert content.final_domain_error == 0.0
     assert np.array_equal(content.final_map(), final_lack.astype(np.float32))
-    rows = trajectory_rows(trajectory)
+    assert_poses_are_the_trajectory(content, trajectory_rows(trajectory), agents)
+    # The points are drawn with y up; the images' pixels land on their cells (no map: the model's frame).
+    assert np.array_equal(content.transforms["/world/agents"], np.diag([1.0, -1.0, 1.0]))
     rows_in_grid = final_lack.shape[0]
+    top_left_pixel_centre = content.transforms["/world/map"] @ np.array([0.5, 0.5, 1.0])
+    assert top_left_pixel_centre[:2] == pytest.approx([0.5 * cell, -(rows_in_grid - 0.5) * cell], abs=1e-5)
+
+
+def assert_poses_are_the_trajectory(content, rows: dict, agents: int) -> None:
+    """Every step's pose in the recording is trajectory.csv's, in the map's frame (float32 in the recording)."""
     compared = 0
     for agent, by_step in content.positions.items():
-        for step, (view_x, view_y) in by_step.items():
-            x, y = rows[(step, agent)]
-            assert view_x == pytest.approx(x / cell, abs=1e-4)
-            assert view_y == pytest.approx(rows_in_grid - y / cell, abs=1e-4)
+        for step, (x, y) in by_step.items():
+            assert (x, y) == pytest.approx(rows[(step, agent)], abs=1e-4)
             compared += 1
-    assert compared == len(rows) - agents  # every step's pose (the final rows have no step of their own)
+    assert compared == len(rows) - agents  # the final rows have no step of their own
 
 
 def test_launch_team_recording_holds_every_entity_and_matches_the_run(tmp_path):
@@ -144,3 +150,25 @@ def test_serve_hosts_a_web_viewer_and_a_grpc_server_while_the_file_is_still_writ
     summary = summarise_recording(out / "recording.rrd")
     assert summary.final_domain_error == 0.0
     assert expected_entities(4) <= set(summary.entities)
+
+
+def test_a_turned_map_s_recording_is_drawn_in_the_map_s_frame(tmp_path):
+    """A map whose origin has a yaw: the recording's poses are trajectory.csv's (the map's frame, as RViz shows
+    it), and the map's images are placed, turned, so that each cell's pixel lies where that cell lies."""
+    from logger.recording import record_result
+    from runtime.rundir import write_run_directory
+    from tests.test_map_fit import turned_scenario
+
+    scenario, turned, _, _ = turned_scenario(tmp_path, yaw=0.5)
+    result = run_scenario(scenario)
+    write_run_directory(result, tmp_path / "out")
+    record_result(result, tmp_path / "out" / "recording.rrd", "turned")
+    content = summarise_recording(tmp_path / "out" / "recording.rrd")
+    assert "/world/map/occupancy" in content.entities
+    assert_poses_are_the_trajectory(content, trajectory_rows(tmp_path / "out" / "trajectory.csv"), 1)
+    rows, cols = scenario.grid_shape
+    for row, col in ((0, 0), (rows - 1, 0), (3, cols - 2)):
+        pixel_centre = np.array([col + 0.5, rows - 1 - row + 0.5, 1.0])  # the image is flipped: row 0 at the top
+        view = content.transforms["/world/map"] @ pixel_centre
+        cell_centre = turned.to_map((col + 0.5) * scenario.cell, (row + 0.5) * scenario.cell)
+        assert (view[0], -view[1]) == pytest.approx(cell_centre, abs=1e-4)  # the view's y points down

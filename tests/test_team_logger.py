@@ -115,11 +115,11 @@ def test_lockstep_gos_become_the_map_the_error_the_poses_and_the_objectives(tmp_
     assert np.array_equal(final, node.replica.map.lack_of_coverage().astype(np.float32))
     assert (final[0:10, 0:20] == 0.0).all() and (final[10:20, 0:10] == 0.5).all()
     assert final.sum() == pytest.approx(CELLS - 250)
-    # Every agent's pose of steps 0 and 1, in the map view (cells, y up).
+    # Every agent's pose of steps 0 and 1, in the map's frame (here the model's).
     for agent in range(4):
         assert content.positions[agent] == {
-            0: pytest.approx((10.0 * agent, ROWS - 40.0)),
-            1: pytest.approx((10.0 * agent + 1.0, ROWS - 40.0)),
+            0: pytest.approx((10.0 * agent, 40.0)),
+            1: pytest.approx((10.0 * agent + 1.0, 40.0)),
         }
     assert {"/world/blobs/objectives", "/world/blobs/segmentation"} <= content.entities
     assert {f"/world/agents/{agent}/objective" for agent in range(4)} <= content.entities
@@ -148,7 +148,7 @@ def test_realtime_steps_membership_and_an_abort(tmp_path):
     node.finish()
 
     content = summarise_recording(path)
-    assert content.positions == {1: {0: pytest.approx((55.0, ROWS - 45.0))}}
+    assert content.positions == {1: {0: pytest.approx((55.0, 45.0))}}
     assert content.domain_error == pytest.approx({1: 1 - 100 / CELLS})
     assert (content.final_map()[50:60, 50:60] == 0.0).all()
     assert events(path) == [
@@ -210,10 +210,10 @@ def test_objectives_draw_a_line_only_from_agents_whose_position_is_known(tmp_pat
 
     content = summarise_recording(path)
     assert content.positions == {}
-    assert "/world/agents/0/objective" in content.entities
+    assert "/world/agents/0/objective" in content.timed
     assert "/world/agents/1/objective" not in content.entities
-    assert "/world/blobs/objectives" not in content.entities  # no blobs in these objectives
-    assert "/world/blobs/segmentation" not in content.entities  # nor labels
+    assert "/world/blobs/objectives" not in content.timed  # no blobs in these objectives (only its static frame)
+    assert "/world/blobs/segmentation" not in content.timed  # nor labels
 
 
 def test_a_snapshot_fills_the_map_and_skips_the_gos_already_in_it(tmp_path):
@@ -231,7 +231,7 @@ def test_a_snapshot_fills_the_map_and_skips_the_gos_already_in_it(tmp_path):
     assert node.replica.duplicates == 0
     node.finish()
     content = summarise_recording(path)
-    assert content.positions == {1: {6: pytest.approx((2.0, ROWS - 1.0))}}
+    assert content.positions == {1: {6: pytest.approx((2.0, 1.0))}}
     final = content.final_map()
     assert (final[90:, 90:] == 0.0).all() and (final[0:10, 0:10] == 0.0).all()
     assert final.sum() == pytest.approx(CELLS - 200)

@@ -8,7 +8,8 @@ naming the key or the file (the scenario loader reports it as a scenario error).
   must agree), and the coverage cell is the map's resolution unless ``cell`` says otherwise (a whole number
   of pixels). The model's domain starts at (0, 0) at the fitted map's lower-left corner; what a user reads
   (trajectory.csv, a ROS 2 base's frames) is in the map's own frame.
-- ``obstacles = [[[x, y], ...], ...]``: polygons, with or without a map.
+- ``obstacles = [[[x, y], ...], ...]``: polygons, with or without a map; with one, in the map's frame (as
+  ``initial_poses`` are).
 - ``wall_detail = "map"`` (the default) or ``"cell"``: how finely bodies and cameras meet the walls
   (:func:`model.world.world.grain_split_of`): to the map's pixel, up to 5 squares a cell side, or to whole
   cells (a cell with any wall pixel is a wall: the fit before issue 34, kept by the drawn maps' studies).

@@ -297,7 +297,11 @@ def _wall_grid(scenario: Scenario) -> tuple[np.ndarray, int, str]:
         walls = coarsen(pixels, fitted.factor // split)
         sha = occupancy_map.sha256
     if scenario.obstacles:
-        polygons = [np.array(polygon, dtype=np.float64) for polygon in scenario.obstacles]
+        # Given in the map's frame, as poses are; the model's frame moves with the crop and turns with the yaw.
+        frame = map_frame_of(scenario)
+        polygons = [
+            np.stack(frame.from_map(*np.array(polygon, dtype=np.float64).T), axis=1) for polygon in scenario.obstacles
+        ]
         walls |= polygons_on_grid(polygons, rows * split, cols * split, scenario.cell / split)
     return walls, split, sha
 
