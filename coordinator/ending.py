@@ -4,15 +4,20 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 from coordinator.endpoints import CoordinatorBus
 from coordinator.stepping import Stepping
 from protocol.messages import RunControl, encode
 from protocol.recovery import fill_gaps
+from protocol.session import logger_listens
 from runtime.rundir import write_run_directory
 
 log = logging.getLogger("anicov.coordinator")
+
+LOGGER_GRACE = 10.0
+"""Seconds the coordinator stays on the bus after the run while a logger still listens (see await_loggers)."""
 
 
 def announce_end(bus: CoordinatorBus, stepping: Stepping) -> bytes | None:
@@ -69,3 +74,19 @@ def write_outputs(bus: CoordinatorBus, stepping: Stepping, resumed_at: int | Non
     if stepping.outcome is not None and out:
         steps, completed, completion_step = stepping.outcome
         write_run_directory(node.result(steps, completed, completion_step), Path(out), counts)
+
+
+def await_loggers(bus: CoordinatorBus, stopped: Callable[[], bool]) -> None:
+    """Stay on the bus until no logger listens (each withdraws its token once it has the run's end), at most
+    LOGGER_GRACE seconds, unless stopped. A logger reads the last gos from the coordinator's history and, if
+    anything is missing, its snapshot: a logger started by hand mid-run, behind on a busy machine, once found
+    the coordinator gone and recorded a final map with cells still uncovered."""
+    deadline = time.monotonic() + LOGGER_GRACE
+    alive = bus.keys.alive("logger")
+    while not stopped():
+        if not logger_listens(bus.session, alive, timeout=0.2):
+            return
+        if time.monotonic() >= deadline:
+            log.warning("a logger still listens %.0f s after the run; leaving it", LOGGER_GRACE)
+            return
+        time.sleep(0.1)

@@ -14,7 +14,7 @@ import os
 
 import zenoh
 
-from coordinator.ending import announce_end, settle_last_deltas, write_outputs
+from coordinator.ending import announce_end, await_loggers, settle_last_deltas, write_outputs
 from coordinator.endpoints import CoordinatorBus
 from coordinator.node import Coordinator, CoordinatorOptions
 from coordinator.startup import gather_team, resume_running_team
@@ -72,6 +72,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
             traffic.stop()
             bus.token.undeclare()
             write_outputs(bus, stepping, step if found.running else None, options.out)
+            await_loggers(bus, lambda: stop.stopped or parent_is_gone(parent))
         finally:
             traffic.stop()  # idempotent: on an error too, its thread must not outlive the session
     if stepping.outcome is None:
