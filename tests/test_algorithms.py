@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from model.controllers.algorithms import Planner, blob_targets
+from model.controllers.algorithms import COMMITMENT, Planner, blob_targets, held_to_their_places
 from model.paper.objectives import BlobObjectives
 from model.scenario import Scenario
 
@@ -50,3 +50,21 @@ def test_a_blob_is_seen_for_an_uncovered_cell_of_its_own():
     assert blob_targets(blobs, lack, 1.0).tolist() == [[5.5, 6.5]]
     lack[6, 5] = 0.0
     assert blob_targets(blobs, lack, 1.0).tolist() == [[5.5, 4.5]]  # rows 4 and 7 left, as near: the first
+
+
+def test_algorithm_2_keeps_each_robot_on_its_place_unless_another_is_much_nearer():
+    """Two robots, three places in a row 1 apart, R = 4: robot 0 at 0.6, sent to place 0 last plan, robot 1 at
+    1.45, sent to place 1; both now nearer place 1 than to any other. On the bare lengths greedy Algorithm 2 gives
+    place 1 to the nearer, robot 0, and robot 1 turns to place 2: as they drive the two swap every plan. Held to
+    the places they were sent to, each keeps its own while no other is COMMITMENT R nearer."""
+    from model.paper.assignment import assign_objectives
+
+    places = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    positions = np.array([[0.6, 0.0], [1.45, 0.0]])
+    lengths = np.abs(positions[:, None, 0] - places[None, :, 0])
+    assert list(assign_objectives(positions, places, lengths)) == [1, 2]  # the nearer: 0.4 against 0.45
+    held = held_to_their_places(lengths, places, [(0.0, 0.0), (1.0, 0.0)], sensing_range=4.0)
+    assert list(assign_objectives(positions, places, held)) == [0, 1]  # each keeps the place it was sent to
+    assert held[0, 0] == max(0.6 - COMMITMENT * 4.0, 0.0) and held[0, 1] == lengths[0, 1]
+    gone = held_to_their_places(lengths, places, [(0.0, 0.5), None], sensing_range=4.0)
+    assert np.array_equal(gone, lengths)  # a place no longer an objective, or none: nothing held

@@ -5,9 +5,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from model.world.clearance import disk_is_free, step_or_stay
-from model.world.geodesic import descent_waypoint, distance_fields, entry_cell, length_by_field, passable_cells
+from model.world.geodesic import (
+    descent_waypoint,
+    distance_fields,
+    entry_cell,
+    length_by_field,
+    passable_cells,
+)
 
 
 def wall_with_a_gap() -> np.ndarray:
@@ -93,3 +100,34 @@ def test_a_robot_inside_the_planning_margin_joins_the_graph_beside_it_instead_of
     assert math.isfinite(distance) and distance > 2 * (32 - 5)  # round the wall's end, not through it
     assert waypoint_y > y  # up, toward the gap: not at the goal behind the wall
     assert length_by_field(field, occupied, 1.0, x, y, 1.0, planning_radius, True) == distance
+
+
+def test_a_robot_past_its_cell_s_centre_with_nothing_in_sight_heads_on_along_the_walk_not_back():
+    """The campus map (0.8 m cells, 0.16 m wall squares, a planning radius of 0.84 m), N = 1 seed 15: at
+    (102.215, 145.258), a hair too near a wall for any drive along its walk, the robot was sent back to its own
+    cell's centre (102.0, 145.2) behind it; reversing, it saw 4 cells along the walk, drove on, came back to this
+    spot, and so round for 12,000 time units. Past its cell's centre it now heads for the walk's next cell."""
+    from model.scenario import load_scenario
+    from model.world.world import world_of
+    from tests.test_real_maps import REAL, map_of
+
+    campus = REAL / "malaga-campus.toml"
+    map_of(campus)
+    scenario = load_scenario(campus)
+    world = world_of(scenario)
+    ground, cell = world.ground, scenario.cell
+    objective = (110.0, 134.8)
+    field = world.field(*objective)
+
+    def waypoint(x: float, y: float) -> tuple[float, float]:
+        return descent_waypoint(
+            field, ground.passable, ground.wall_grid, ground.grain, x, y, *objective, cell, ground.lookahead,
+            ground.plan_radius, ground.bounded,
+        )[1:]  # fmt: skip
+
+    assert entry_cell(field, ground.wall_grid, ground.grain, 102.215, 145.258, cell, ground.plan_radius, True) == (
+        181,
+        127,
+    )  # its own cell, whose centre is (102.0, 145.2)
+    assert waypoint(102.215, 145.258) == pytest.approx((102.8, 145.2))  # the walk's next cell, ahead
+    assert waypoint(102.205, 145.236) == pytest.approx((105.2, 145.2))  # a hair farther off the wall: 4 cells on
