@@ -53,18 +53,18 @@ def test_a_blob_is_seen_for_an_uncovered_cell_of_its_own():
 
 
 def test_algorithm_2_keeps_each_robot_on_its_place_unless_another_is_much_nearer():
-    """Two robots, three places in a row 1 apart, R = 4: robot 0 at 0.6, sent to place 0 last plan, robot 1 at
+    """Two robots, three places in a row 1 apart, cells of 0.5: robot 0 at 0.6, sent to place 0 last plan, robot 1 at
     1.45, sent to place 1; both now nearer place 1 than to any other. On the bare lengths greedy Algorithm 2 gives
     place 1 to the nearer, robot 0, and robot 1 turns to place 2: as they drive the two swap every plan. Held to
-    the places they were sent to, each keeps its own while no other is COMMITMENT R nearer."""
+    the places they were sent to, each keeps its own while no other is COMMITMENT cells nearer."""
     from model.paper.assignment import assign_objectives
 
     places = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
     positions = np.array([[0.6, 0.0], [1.45, 0.0]])
     lengths = np.abs(positions[:, None, 0] - places[None, :, 0])
     assert list(assign_objectives(positions, places, lengths)) == [1, 2]  # the nearer: 0.4 against 0.45
-    held = held_to_their_places(lengths, places, [(0.0, 0.0), (1.0, 0.0)], sensing_range=4.0)
+    held = held_to_their_places(lengths, places, [(0.0, 0.0), (1.0, 0.0)], cell=0.5)
     assert list(assign_objectives(positions, places, held)) == [0, 1]  # each keeps the place it was sent to
-    assert held[0, 0] == max(0.6 - COMMITMENT * 4.0, 0.0) and held[0, 1] == lengths[0, 1]
-    gone = held_to_their_places(lengths, places, [(0.0, 0.5), None], sensing_range=4.0)
+    assert held[0, 0] == max(0.6 - COMMITMENT * 0.5, 0.0) and held[0, 1] == lengths[0, 1]
+    gone = held_to_their_places(lengths, places, [(0.0, 0.5), None], cell=0.5)
     assert np.array_equal(gone, lengths)  # a place no longer an objective, or none: nothing held

@@ -53,7 +53,7 @@ def test_the_radius_narrows_the_free_space():
 def test_with_the_objective_in_sight_the_global_law_is_the_papers():
     free = np.zeros((40, 40), dtype=bool)
     field = distance_fields(~free, [(30, 30)], 1.0)[0]
-    assert descent_waypoint(field, ~free, free, 1.0, 5.0, 7.0, 30.5, 30.5, 1.0, 20, 0.5, True) == (
+    assert descent_waypoint(field, ~free, free, 1.0, 5.0, 7.0, 30.5, 30.5, 1.0, 20, 0.5, True, 0.5) == (
         math.hypot(25.5, 23.5),
         30.5,
         30.5,
@@ -70,7 +70,7 @@ def test_following_the_waypoints_gets_round_the_wall_where_heading_straight_stal
         x, y, theta = 5.5, 5.5, 0.0
         for _ in range(1500):
             target = (
-                descent_waypoint(field, passable, occupied, 1.0, x, y, *goal, 1.0, 20, radius, True)[1:]
+                descent_waypoint(field, passable, occupied, 1.0, x, y, *goal, 1.0, 20, radius, True, radius)[1:]
                 if aim_at_waypoints
                 else goal
             )
@@ -96,7 +96,7 @@ def test_a_robot_inside_the_planning_margin_joins_the_graph_beside_it_instead_of
     assert math.isinf(field[5, 19])
     row, col = entry_cell(field, occupied, 1.0, x, y, 1.0, planning_radius, True)
     assert (row, col) != (-1, -1) and math.isfinite(field[row, col]) and abs(col - 19) <= 2
-    distance, _, waypoint_y = descent_waypoint(field, passable, occupied, 1.0, x, y, *goal, 1.0, 20, 0.75, True)
+    distance, _, waypoint_y = descent_waypoint(field, passable, occupied, 1.0, x, y, *goal, 1.0, 20, 0.75, True, 0.7)
     assert math.isfinite(distance) and distance > 2 * (32 - 5)  # round the wall's end, not through it
     assert waypoint_y > y  # up, toward the gap: not at the goal behind the wall
     assert length_by_field(field, occupied, 1.0, x, y, 1.0, planning_radius, True) == distance
@@ -122,7 +122,7 @@ def test_a_robot_past_its_cell_s_centre_with_nothing_in_sight_heads_on_along_the
     def waypoint(x: float, y: float) -> tuple[float, float]:
         return descent_waypoint(
             field, ground.passable, ground.wall_grid, ground.grain, x, y, *objective, cell, ground.lookahead,
-            ground.plan_radius, ground.bounded,
+            ground.plan_radius, ground.bounded, ground.wall_clearance,
         )[1:]  # fmt: skip
 
     assert entry_cell(field, ground.wall_grid, ground.grain, 102.215, 145.258, cell, ground.plan_radius, True) == (

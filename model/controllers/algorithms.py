@@ -19,9 +19,9 @@ from model.world.crowding import spread_shared, team_spacing
 from model.world.reachability import viewpoints
 from model.world.world import map_frame_of, viewing_range_of, world_of
 
-COMMITMENT = 0.5
-"""On a terrain, how much nearer, in camera ranges R, Algorithm 2 counts the place each robot was sent to in the
-plan before, while that place is still an objective (:func:`held_to_their_places`)."""
+COMMITMENT = 1.0
+"""On a terrain, how much nearer, in cells, Algorithm 2 counts the place each robot was sent to in the plan
+before, while that place is still an objective (:func:`held_to_their_places`)."""
 
 
 @dataclass
@@ -68,7 +68,7 @@ class Planner(TeamPlanner):
         )
         lengths = path_lengths(world, positions, places)
         ids = list(range(len(positions))) if members is None else list(members)
-        held = held_to_their_places(lengths, places, [self.sent.get(agent) for agent in ids], self.scenario.range)
+        held = held_to_their_places(lengths, places, [self.sent.get(agent) for agent in ids], self.scenario.cell)
         choice = assign_objectives(positions, places, held)
         self.sent = {agent: (float(places[j, 0]), float(places[j, 1])) for agent, j in zip(ids, choice, strict=True)}
         if (spacing := team_spacing(self.scenario)) > 0.0:
@@ -77,10 +77,10 @@ class Planner(TeamPlanner):
 
 
 def held_to_their_places(
-    lengths: np.ndarray, places: np.ndarray, sent: list[tuple[float, float] | None], sensing_range: float
+    lengths: np.ndarray, places: np.ndarray, sent: list[tuple[float, float] | None], cell: float
 ) -> np.ndarray:
     """``lengths`` (N, M) with each robot's way to the place it was sent to before (``sent``, per robot; None:
-    nowhere) shortened by COMMITMENT R (not below 0), where that place is still one of ``places``: a robot keeps
+    nowhere) shortened by COMMITMENT cells (not below 0), where that place is still one of ``places``: a robot keeps
     its objective unless another is that much nearer. Greedy Algorithm 2 on the bare lengths swapped two robots
     between three places every plan as they drove, each turning back before it arrived: on the lab map (N = 8
     seed 11, N = 4 seed 9 in a trial) they covered nothing for 200 time units and 4 cells were given up."""
@@ -89,7 +89,7 @@ def held_to_their_places(
         if place is None:
             continue
         same = np.flatnonzero((places[:, 0] == place[0]) & (places[:, 1] == place[1]))
-        held[robot, same] = np.maximum(held[robot, same] - COMMITMENT * sensing_range, 0.0)
+        held[robot, same] = np.maximum(held[robot, same] - COMMITMENT * cell, 0.0)
     return held
 
 

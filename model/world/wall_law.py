@@ -92,8 +92,9 @@ def _waypoint(
     passable, walls, grain = ground.passable, ground.wall_grid, ground.grain
     lookahead, radius, bounded = ground.lookahead, ground.plan_radius, ground.bounded
     return descent_waypoint(
-        field, passable, walls, grain, x, y, objective_x, objective_y, cell, lookahead, radius, bounded
-    )
+        field, passable, walls, grain, x, y, objective_x, objective_y, cell, lookahead, radius, bounded,
+        ground.wall_clearance,
+    )  # fmt: skip
 
 
 @njit(cache=True)
