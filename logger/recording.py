@@ -70,14 +70,13 @@ Y_UP = rr.Transform3D(mat3x3=np.diag([1.0, -1.0, 1.0]))
 def pixels_to_view(frame: MapFrame, rows: int, cell: float) -> rr.Transform3D:
     """Where a map view image (a grid of ``rows`` rows of ``cell``, flipped so that row 0 is the top) lies:
     pixel (u, v) is the model's point (u·cell, (rows − v)·cell), placed in the map's frame by ``frame`` and
-    flipped to the view's y down, as :data:`Y_UP` flips the points."""
-    cos_yaw, sin_yaw = np.cos(frame.yaw), np.sin(frame.yaw)
-    turn = np.array([[cos_yaw, -sin_yaw], [sin_yaw, cos_yaw]])
-    linear = np.diag([1.0, -1.0]) @ turn @ np.diag([cell, -cell])
-    top_left = np.array(frame.corner) + turn @ np.array([0.0, rows * cell])
+    flipped to the view's y down, as :data:`Y_UP` flips the points. An affine map, read off where ``frame``
+    puts pixel (0, 0) and one pixel along each axis."""
+    xs, ys = frame.to_map(np.array([0.0, cell, 0.0]), np.full(3, rows * cell) - np.array([0.0, 0.0, cell]))
+    origin, along_u, along_v = np.stack([xs, -ys], axis=1)
     matrix = np.eye(3)
-    matrix[:2, :2] = linear
-    return rr.Transform3D(translation=[top_left[0], -top_left[1], 0.0], mat3x3=matrix)
+    matrix[:2, 0], matrix[:2, 1] = along_u - origin, along_v - origin
+    return rr.Transform3D(translation=[origin[0], origin[1], 0.0], mat3x3=matrix)
 
 
 def default_blueprint(agents: int) -> rrb.Blueprint:

@@ -41,8 +41,8 @@ class Planner(TeamPlanner):
         objective is taken at the centre of the blob's cell it was found in, then moved to where a robot can see it from (:func:`model.world.reachability.viewpoints`)
         and Algorithm 2 takes the lengths of the shortest free paths to them (:func:`path_lengths`); robots with
         bodies that share an objective each get a place of their own (:mod:`model.world.crowding`)."""
+        ids = list(range(len(positions))) if members is None else list(members)
         if self.scenario.objectives:  # in the map's frame, with a map (model.scenario.safety_keys)
-            ids = range(len(positions)) if members is None else members
             fixed = np.array([self.scenario.objectives[agent] for agent in ids], dtype=np.float64).reshape(-1, 2)
             return np.stack(map_frame_of(self.scenario).from_map(fixed[:, 0], fixed[:, 1]), axis=1)
         world = world_of(self.scenario)
@@ -67,7 +67,6 @@ class Planner(TeamPlanner):
             self.scenario.cell,
         )
         lengths = path_lengths(world, positions, places)
-        ids = list(range(len(positions))) if members is None else list(members)
         held = held_to_their_places(lengths, places, [self.sent.get(agent) for agent in ids], self.scenario.cell)
         choice = assign_objectives(positions, places, held)
         self.sent = {agent: (float(places[j, 0]), float(places[j, 1])) for agent, j in zip(ids, choice, strict=True)}
