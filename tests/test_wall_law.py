@@ -190,3 +190,32 @@ def test_a_robot_goes_all_the_way_to_a_covered_objective_and_looks_from_there():
         )  # fmt: skip
         assert u_glo == pytest.approx((2.0 / math.pi) * math.atan(gap)) and theta == pytest.approx(0.0)
         assert np.isnan(look).all()
+
+
+def test_on_its_way_to_a_covered_objective_a_robot_stops_for_an_uncovered_cell_within_r_less_a_cell():
+    # Driving on past what it was sent to see cost the drawn office map (N = 10, occlusion) 9 % of its time.
+    coverage = one_uncovered_cell(10, 14)
+    objective = (11.5, 10.5)  # covered; the uncovered cell (14.5, 10.5) lies 2.2 from a robot at 12.3
+    open_ground = ground_of(np.zeros((20, 20), dtype=bool))
+    look = no_look()
+    u_glo, theta = global_law_among_walls(
+        coverage, TARGET, 12.3, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, open_ground, np.zeros((20, 20)),
+        np.zeros((0, 2)), look,
+    )  # fmt: skip
+    assert u_glo == 0.0 and theta == pytest.approx(0.0) and tuple(look) == (14.5, 10.5)
+    occupied = np.zeros((20, 20), dtype=bool)
+    occupied[9:12, 13] = True  # a wall hides the cell: on to the point
+    walled = ground_of(occupied)
+    look = no_look()
+    u_glo, theta = global_law_among_walls(
+        coverage, TARGET, 12.3, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, walled, np.zeros((20, 20)),
+        np.zeros((0, 2)), look,
+    )  # fmt: skip
+    assert u_glo > 0.0 and theta == pytest.approx(math.pi) and np.isnan(look).all()
+    beyond = one_uncovered_cell(10, 15)  # 3.2 away: beyond R less a cell (3), within R
+    look = no_look()
+    u_glo, _ = global_law_among_walls(
+        beyond, TARGET, 12.3, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, open_ground, np.zeros((20, 20)),
+        np.zeros((0, 2)), look,
+    )  # fmt: skip
+    assert u_glo > 0.0 and np.isnan(look).all()
