@@ -125,6 +125,38 @@ def test_the_improved_order_finds_the_best_of_all_orders_of_five_and_is_never_la
     assert improved_order(np.array(owners), positions, cut_on)[1] <= resized + 1e-6
 
 
+def _steepest_descent_by_definition(
+    order: np.ndarray, positions: np.ndarray, cut_on: Spiral
+) -> tuple[np.ndarray, float]:
+    """improved_order as its docstring defines it: every neighbour's rough finish bisected, the first least
+    taken while it is sooner."""
+    best = float(order_finishes(order[None, :], positions, cut_on)[0])
+    while True:
+        around = neighbours(order)
+        rough = order_finishes(around, positions, cut_on, below=np.full(len(around), best))
+        k = int(np.argmin(rough))
+        exact = float(order_finishes(around[k : k + 1], positions, cut_on)[0])
+        if rough[k] >= best - 1e-9 or exact >= best - 1e-9:
+            return order, best
+        order, best = around[k], exact
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_improved_order_is_the_steepest_descent_over_every_neighbours_bisected_finish(seed):
+    # improved_order walks each neighbour at one T and bisects only those that reach the end there, from the
+    # first place it changes: the same orders, to the bit, as bisecting all of them.
+    whole, _ = _spiral()
+    cut_on = Spiral(whole.points, whole.along, LEAD, CENTRE_ALLOWANCE_LEADS * LEAD, SEAM_OVERLAP)
+    rng = np.random.default_rng(seed)
+    agents = int(rng.integers(3, 16))
+    positions = rng.uniform(-10.0, 110.0, (agents, 2))
+    start = rng.permutation(agents)
+    order, finish = improved_order(start, positions, cut_on)
+    expected_order, expected_finish = _steepest_descent_by_definition(start, positions, cut_on)
+    assert order.tolist() == expected_order.tolist() and finish == expected_finish
+    assert finish < float(order_finishes(start[None, :], positions, cut_on)[0])  # it did improve
+
+
 def test_a_robot_starting_near_the_spirals_first_point_gets_twice_the_run_up_and_leaves_its_corner_covered():
     whole, _ = _spiral()
     start = whole.points[0]

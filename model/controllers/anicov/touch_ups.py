@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from numba import njit
 
 from model.controllers.anicov.law import anicov_law
 from model.controllers.anicov.route import Route, Stop
@@ -34,8 +35,8 @@ from model.paper.coverage_map import add_window
 from model.paper.dynamics import unicycle_step
 from model.parameters import coverage_map_of
 from model.scenario import Scenario
-from model.step import pursue
-from model.world.ground import open_ground
+from model.step import LawParameters, pursue
+from model.world.ground import Ground, open_ground
 from model.world.wedge import sense_wedge_among
 
 ORBIT_RADIUS = 1.5
@@ -88,22 +89,44 @@ def simulate_routes(
         theta = math.atan2(carrot[1] - y, carrot[0] - x)
         step = 0
         while step < MAX_SIMULATED_STEPS:
-            if step % plan_steps == 0:
-                route.advance(np.array([x, y]), lookahead)
-                if route.done():
-                    break
-                carrot = route.carrot(np.array([x, y]), lookahead, law.face_radius)
-            v, omega = pursue(x, y, theta, carrot[0], carrot[1], law)
-            _, _, _, row0, col0, window = sense_wedge_among(
-                ticks, law.target_ticks, x, y, theta, law.sensing_range, law.half_angle, law.alpha_max,
-                law.dt, law.cell, ground, nobody,
-            )  # fmt: skip
-            add_window(ticks, row0, col0, window, law.target_ticks)
-            x, y, theta = unicycle_step(x, y, theta, v, omega, scenario.dt)
-            step += 1
+            route.advance(np.array([x, y]), lookahead)
+            if route.done():
+                break
+            carrot = route.carrot(np.array([x, y]), lookahead, law.face_radius)
+            period = min(plan_steps, MAX_SIMULATED_STEPS - step)
+            x, y, theta = _fly(ticks, x, y, theta, float(carrot[0]), float(carrot[1]), period, law, ground, nobody)
+            step += period
         times[index] = step * scenario.dt
     lack = np.maximum(law.target_ticks - ticks, 0).astype(np.float64) / law.target_ticks
     return lack, ticks, times
+
+
+@njit(cache=True)
+def _fly(
+    ticks: np.ndarray,
+    x: float,
+    y: float,
+    theta: float,
+    carrot_x: float,
+    carrot_y: float,
+    steps: int,
+    law: LawParameters,
+    ground: Ground,
+    nobody: np.ndarray,
+) -> tuple[float, float, float]:
+    """(x, y, θ) after ``steps`` steps toward the carrot, as the engine flies them: each step
+    :func:`model.paper.control.pursuit_law`, the wedge's coverage (eq. 2-3) added to ``ticks`` and the
+    unicycle (eq. 1). One compiled call per plan period: called per step, the calls were most of the first
+    plan's simulation at N = 100."""
+    for _ in range(steps):
+        v, omega = pursue(x, y, theta, carrot_x, carrot_y, law)
+        _, _, _, row0, col0, window = sense_wedge_among(
+            ticks, law.target_ticks, x, y, theta, law.sensing_range, law.half_angle, law.alpha_max, law.dt,
+            law.cell, ground, nobody,
+        )  # fmt: skip
+        add_window(ticks, row0, col0, window, law.target_ticks)
+        x, y, theta = unicycle_step(x, y, theta, v, omega, law.dt)
+    return x, y, theta
 
 
 def orbit(centre: np.ndarray, radius: float, start_angle: float, turns: int) -> np.ndarray:
