@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
+from numba import njit
 
-from model.paper.polyline import point_along
 from model.scenario import Scenario
 
 CARROT_PERIOD = 0.5
@@ -65,58 +65,35 @@ class Route:
 
     def point_at(self, distance: float) -> np.ndarray:
         """The point ``distance`` along the route, held to its ends."""
-        if len(self.points) == 1:
-            return self.points[0].copy()
-        return point_along(self.points, self.along, min(max(distance, 0.0), self.length))
+        return np.array(point_on(self.points, self.along, distance))
 
     def advance(self, position: np.ndarray, window: float) -> None:
         """Progress := the nearest point of the route to ``position`` at most ``window`` ahead of where
         it was: no farther than the carrot the robot was given (so a neighbouring ring is never taken,
         nor, on a pass that doubles back over a small blob, the way back while it is still going out);
-        the first such along the route on a tie; never past a stop not yet done."""
+        the first such along the route on a tie; never past a stop not yet done (:func:`advanced`)."""
         reach = self.progress + window
         if self.stops:
             reach = min(reach, self.stops[0].at)
-        best, best_distance = self.progress, math.inf
-        for k in range(len(self.points) - 1):
-            start, end = self.along[k], self.along[k + 1]
-            if end < self.progress or start > reach:
-                continue
-            at = min(max(self._foot(k, position), self.progress), reach)
-            gap = float(np.linalg.norm(self.point_at(at) - position))
-            if gap < best_distance - 1e-9:
-                best, best_distance = at, gap
-        self.progress = max(self.progress, best)
+        self.progress = advanced(self.points, self.along, self.progress, reach, float(position[0]), float(position[1]))
 
     def done(self) -> bool:
         return self.progress >= self.length - 1e-6 and not self.stops
 
     def carrot(self, position: np.ndarray, lookahead: float, face_radius: float) -> np.ndarray:
-        """The carrot for the coming plan period (after :meth:`advance`): ``lookahead`` ahead along the
-        route, held at the next stop; at a stop (the robot within ``face_radius`` of it), a point
-        ``face_radius`` / 2 from the robot in the next bearing to face there, which the law turns toward
-        (:func:`model.paper.control.pursuit_law`), that bearing then done."""
-        if self.stops and float(np.linalg.norm(position - self.point_at(self.stops[0].at))) < face_radius:
-            # There (the law stands within ``face_radius`` of a carrot, so progress may stop short).
-            stop = self.stops[0]
-            self.progress = max(self.progress, stop.at)
-            bearing = stop.bearings.pop(0)
-            if not stop.bearings:
+        """The carrot for the coming plan period (after :meth:`advance`; :func:`carrot_on`): ``lookahead``
+        ahead along the route, held at the next stop; at a stop, a bearing to face there, that bearing then
+        done."""
+        stop_at, bearing = (self.stops[0].at, self.stops[0].bearings[0]) if self.stops else (math.nan, 0.0)
+        x, y = float(position[0]), float(position[1])
+        carrot_x, carrot_y, self.progress, faced = carrot_on(
+            self.points, self.along, self.progress, stop_at, bearing, x, y, lookahead, face_radius
+        )
+        if faced:
+            self.stops[0].bearings.pop(0)
+            if not self.stops[0].bearings:
                 self.stops.pop(0)
-            return np.asarray(position, dtype=np.float64) + 0.5 * face_radius * np.array(
-                [math.cos(bearing), math.sin(bearing)]
-            )
-        ahead = self.progress + lookahead
-        if self.stops:
-            ahead = min(ahead, self.stops[0].at)
-        target = self.point_at(ahead)
-        if float(np.linalg.norm(target - position)) < face_radius:
-            # The law would stand here (a carrot this near is a bearing): at the route's end it is done (at
-            # the next plan); where the route doubles back past the robot, it has come this far.
-            self.progress = self.length if ahead >= self.length - 1e-9 else ahead
-            if ahead < self.length - 1e-9 and not (self.stops and ahead >= self.stops[0].at):
-                return self.carrot(position, lookahead, face_radius)
-        return target
+        return np.array([carrot_x, carrot_y])
 
     def nearest(self, position: np.ndarray) -> tuple[float, float]:
         """(distance, arc length) of the route's point nearest to ``position``, the first on a tie."""
@@ -124,19 +101,11 @@ class Route:
             return float(np.linalg.norm(self.points[0] - position)), 0.0
         best_gap, best_at = math.inf, 0.0
         for k in range(len(self.points) - 1):
-            at = self._foot(k, position)
+            at = _foot(self.points, self.along, k, float(position[0]), float(position[1]))
             gap = float(np.linalg.norm(self.point_at(at) - position))
             if gap < best_gap - 1e-9:
                 best_gap, best_at = gap, at
         return best_gap, best_at
-
-    def _foot(self, k: int, position: np.ndarray) -> float:
-        """Arc length of the point of segment k nearest to ``position``."""
-        a, b = self.points[k], self.points[k + 1]
-        d = b - a
-        span2 = float(d @ d)
-        t = 0.0 if span2 == 0.0 else float(np.clip((position - a) @ d / span2, 0.0, 1.0))
-        return float(self.along[k] + t * (self.along[k + 1] - self.along[k]))
 
     def draw_ahead(self, canvas: np.ndarray, cell: float, width: int) -> None:
         """Draw what is left of the route (from its progress on) into ``canvas`` (uint8 grid), ``width``
@@ -144,3 +113,80 @@ class Route:
         ahead = self.points[self.along > self.progress]
         line = np.vstack([self.point_at(self.progress), ahead]) / cell
         cv2.polylines(canvas, [np.round(line).astype(np.int32)], False, 1, thickness=width)
+
+
+@njit(cache=True)
+def point_on(points: np.ndarray, along: np.ndarray, distance: float) -> tuple[float, float]:
+    """:meth:`Route.point_at` of the polyline ``points`` (K, 2) with arc lengths ``along`` (K,), compiled
+    (:func:`model.paper.polyline.point_along`'s arithmetic, held to the ends)."""
+    if len(points) == 1:
+        return points[0, 0], points[0, 1]
+    distance = min(max(distance, 0.0), along[-1])
+    segment = min(np.searchsorted(along, distance, side="right") - 1, len(points) - 2)
+    share = (distance - along[segment]) / max(along[segment + 1] - along[segment], 1e-300)
+    x = points[segment, 0] + share * (points[segment + 1, 0] - points[segment, 0])
+    y = points[segment, 1] + share * (points[segment + 1, 1] - points[segment, 1])
+    return x, y
+
+
+@njit(cache=True)
+def advanced(points: np.ndarray, along: np.ndarray, progress: float, reach: float, x: float, y: float) -> float:
+    """:meth:`Route.advance`'s new progress: the nearest point of the route to (x, y) between ``progress``
+    and ``reach`` (arc lengths), the first on a tie, never behind ``progress``."""
+    best, best_distance = progress, math.inf
+    for k in range(len(points) - 1):
+        start, end = along[k], along[k + 1]
+        if end < progress or start > reach:
+            continue
+        at = min(max(_foot(points, along, k, x, y), progress), reach)
+        point_x, point_y = point_on(points, along, at)
+        gap = math.sqrt((point_x - x) * (point_x - x) + (point_y - y) * (point_y - y))
+        if gap < best_distance - 1e-9:
+            best, best_distance = at, gap
+    return max(progress, best)
+
+
+@njit(cache=True)
+def carrot_on(
+    points: np.ndarray,
+    along: np.ndarray,
+    progress: float,
+    stop_at: float,
+    bearing: float,
+    x: float,
+    y: float,
+    lookahead: float,
+    face_radius: float,
+) -> tuple[float, float, float, bool]:
+    """(carrot x, y, new progress, whether the stop's bearing was faced) of :meth:`Route.carrot`: ``lookahead``
+    ahead along the route, held at the next stop (``stop_at``; NaN: none); at that stop (the robot within
+    ``face_radius`` of it), a point ``face_radius`` / 2 from the robot in ``bearing``, which the law turns
+    toward (:func:`model.paper.control.pursuit_law`). A carrot nearer than ``face_radius`` is a bearing the law
+    would stand at: at the route's end the route is done (at the next plan); where the route doubles back
+    past the robot, it has come this far, and the carrot is taken from there."""
+    length = along[-1]
+    has_stop = stop_at == stop_at
+    if has_stop:
+        stop_x, stop_y = point_on(points, along, stop_at)
+        if math.sqrt((x - stop_x) * (x - stop_x) + (y - stop_y) * (y - stop_y)) < face_radius:
+            reach = 0.5 * face_radius
+            return x + reach * math.cos(bearing), y + reach * math.sin(bearing), max(progress, stop_at), True
+    while True:
+        ahead = progress + lookahead
+        if has_stop:
+            ahead = min(ahead, stop_at)
+        target_x, target_y = point_on(points, along, ahead)
+        if math.sqrt((target_x - x) * (target_x - x) + (target_y - y) * (target_y - y)) < face_radius:
+            progress = length if ahead >= length - 1e-9 else ahead
+            if ahead < length - 1e-9 and not (has_stop and ahead >= stop_at):
+                continue
+        return target_x, target_y, progress, False
+
+
+@njit(cache=True)
+def _foot(points: np.ndarray, along: np.ndarray, k: int, x: float, y: float) -> float:
+    """Arc length of the point of segment k nearest to (x, y)."""
+    d_x, d_y = points[k + 1, 0] - points[k, 0], points[k + 1, 1] - points[k, 1]
+    span2 = d_x * d_x + d_y * d_y
+    t = 0.0 if span2 == 0.0 else min(max(((x - points[k, 0]) * d_x + (y - points[k, 1]) * d_y) / span2, 0.0), 1.0)
+    return along[k] + t * (along[k + 1] - along[k])

@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from model.controllers.anicov.law import anicov_law
-from model.controllers.anicov.route import Route, Stop
+from model.controllers.anicov.route import Route, Stop, advanced, carrot_on, point_on
 from model.paper.coverage_map import add_window
 from model.paper.dynamics import unicycle_step
 from model.parameters import coverage_map_of
@@ -84,21 +84,63 @@ def simulate_routes(
     plan_steps = scenario.plan_steps  # read once: it asks the scenario's controller
     for index, points in enumerate(routes):
         route = Route.of(points, stops=None if stops is None else stops[index])
+        stop_at = np.array([stop.at for stop in route.stops], dtype=np.float64)
+        bearings = np.array([bearing for stop in route.stops for bearing in stop.bearings], dtype=np.float64)
+        faced_after = np.cumsum([len(stop.bearings) for stop in route.stops], dtype=np.int64)
         x, y = float(positions[index][0]), float(positions[index][1])
-        carrot = route.point_at(lookahead)
-        theta = math.atan2(carrot[1] - y, carrot[0] - x)
-        step = 0
-        while step < MAX_SIMULATED_STEPS:
-            route.advance(np.array([x, y]), lookahead)
-            if route.done():
-                break
-            carrot = route.carrot(np.array([x, y]), lookahead, law.face_radius)
-            period = min(plan_steps, MAX_SIMULATED_STEPS - step)
-            x, y, theta = _fly(ticks, x, y, theta, float(carrot[0]), float(carrot[1]), period, law, ground, nobody)
-            step += period
-        times[index] = step * scenario.dt
+        steps = _fly_route(
+            ticks, x, y, route.points, route.along, (stop_at, bearings, faced_after), lookahead, plan_steps, law,
+            ground, nobody,
+        )  # fmt: skip
+        times[index] = steps * scenario.dt
     lack = np.maximum(law.target_ticks - ticks, 0).astype(np.float64) / law.target_ticks
     return lack, ticks, times
+
+
+@njit(cache=True)
+def _fly_route(
+    ticks: np.ndarray,
+    x: float,
+    y: float,
+    points: np.ndarray,
+    along: np.ndarray,
+    stops: tuple[np.ndarray, np.ndarray, np.ndarray],
+    lookahead: float,
+    plan_steps: int,
+    law: LawParameters,
+    ground: Ground,
+    nobody: np.ndarray,
+) -> int:
+    """Steps until a route is done, flown from (x, y) as :mod:`model.controllers.anicov.lane_planner` steers
+    it, with :class:`model.controllers.anicov.route.Route`'s own compiled steps (:func:`advanced`,
+    :func:`carrot_on`), the robot heading at its first carrot; the wedge's coverage added to ``ticks``.
+    ``stops``: the stations' arc lengths (S,), their bearings one after another, and how many bearings are
+    faced once each station is done (S,). Compiled whole: called from Python every plan period, the
+    flights were most of the first plan at N = 100."""
+    stop_at, bearings, faced_after = stops
+    length = along[-1]
+    carrot_x, carrot_y = point_on(points, along, lookahead)
+    theta = math.atan2(carrot_y - y, carrot_x - x)
+    progress, stop, faced, step = 0.0, 0, 0, 0
+    while step < MAX_SIMULATED_STEPS:
+        next_stop, bearing = (stop_at[stop], bearings[faced]) if stop < len(stop_at) else (math.nan, 0.0)
+        reach = progress + lookahead
+        if stop < len(stop_at):
+            reach = min(reach, next_stop)
+        progress = advanced(points, along, progress, reach, x, y)
+        if progress >= length - 1e-6 and stop == len(stop_at):  # Route.done
+            break
+        carrot_x, carrot_y, progress, turned = carrot_on(
+            points, along, progress, next_stop, bearing, x, y, lookahead, law.face_radius
+        )
+        if turned:
+            faced += 1
+            if faced == faced_after[stop]:
+                stop += 1
+        period = min(plan_steps, MAX_SIMULATED_STEPS - step)
+        x, y, theta = _fly(ticks, x, y, theta, carrot_x, carrot_y, period, law, ground, nobody)
+        step += period
+    return step
 
 
 @njit(cache=True)
@@ -116,8 +158,7 @@ def _fly(
 ) -> tuple[float, float, float]:
     """(x, y, θ) after ``steps`` steps toward the carrot, as the engine flies them: each step
     :func:`model.paper.control.pursuit_law`, the wedge's coverage (eq. 2-3) added to ``ticks`` and the
-    unicycle (eq. 1). One compiled call per plan period: called per step, the calls were most of the first
-    plan's simulation at N = 100."""
+    unicycle (eq. 1)."""
     for _ in range(steps):
         v, omega = pursue(x, y, theta, carrot_x, carrot_y, law)
         _, _, _, row0, col0, window = sense_wedge_among(
