@@ -11,21 +11,18 @@ The allowance may be shared: a robot that reaches the end with less than the all
 rest to the next in the order, who flies no spiral, goes to the centre and is counted what it has left (on
 the paper's square at N = 30 most plans end so: two robots share the centre's orbit and passes). A robot
 whose transit alone is longer than T flies no piece, nor do the robots after the end is reached; they take
-passes from the start. The order is improved by local search (:func:`improved_order`): every swap of two
-robots and every move of one robot to another place in the order, the soonest (as far as a bracket 20 %
-under the best so far tells) taken while one is sooner. :func:`model.controllers.anicov.routes.balanced_routes` starts it from
+passes from the start. The order is improved by local search
+(:func:`model.controllers.anicov.order_search.improved_order`): every swap of two robots and every move of
+one robot to another place in the order, the soonest (as far as a bracket 20 % under the best so far
+tells) taken while one is sooner. :func:`model.controllers.anicov.routes.balanced_routes` starts it from
 the order of its resized pieces: on the paper's square (16 seeds, 2026-12-04) that alone made N = 20 2.965
 -> 2.906 t* and N = 30 3.395 -> 3.216, and N = 2 - 10 moved by less than 0.01. Resizing the pieces in
 rounds, robots reassigned in each, did not settle where thirty robots and thirty pieces are all a transit
-apart: their estimated finish was 3.69 t*_30 on average, this search's 2.95. A round walks each neighbour's
-pieces at one finish, from the first place it changes, and bisects only those that reach the end there
-(:func:`_soonest_neighbour`, compiled): the same orders to the bit as bisecting all of them, and the paper's
-square at N = 100 plans its order in seconds, not a minute (bench/bench_planner.py).
+apart: their estimated finish was 3.69 t*_30 on average, this search's 2.95.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -39,8 +36,6 @@ BISECTIONS = 40
 """Halvings of the bracket of an order's finish (from one spiral length: far below a time step)."""
 NEIGHBOUR_BISECTIONS = 14
 """Halvings when only whether a neighbour beats the best so far is asked (from within 20 % below it)."""
-MAX_ROUNDS = 60
-"""Local search rounds at most (a round takes the best of all swaps and moves)."""
 
 
 @dataclass(frozen=True)
@@ -107,7 +102,7 @@ def order_finishes(
     else:
         low, high, halvings = 0.8 * below, np.array(below, dtype=np.float64), NEIGHBOUR_BISECTIONS
     return np.array(
-        [_bisected(order, lo, hi, halvings, np.inf, walk) for order, lo, hi in zip(orders, low, high, strict=True)]
+        [bisected(order, lo, hi, halvings, np.inf, walk) for order, lo, hi in zip(orders, low, high, strict=True)]
     )
 
 
@@ -118,7 +113,7 @@ def _span(positions: np.ndarray, spiral: Spiral) -> float:
 
 
 WalkArrays = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, float]
-"""What :func:`_walk` reads (:func:`walk_arrays`): each robot's way to the spiral's first point (N,) and
+"""What :func:`walk_pieces` reads (:func:`walk_arrays`): each robot's way to the spiral's first point (N,) and
 position (N, 2), the spiral's polyline (K, 2) and arc lengths (K,), its seams' overlap and the centre's
 allowance."""
 
@@ -151,7 +146,9 @@ def _point_at(points: np.ndarray, along: np.ndarray, at: float) -> tuple[float, 
 
 
 @njit(cache=True)
-def _walk(order: np.ndarray, start: int, stop: int, cut: float, finish: float, walk: WalkArrays) -> tuple[bool, float]:
+def walk_pieces(
+    order: np.ndarray, start: int, stop: int, cut: float, finish: float, walk: WalkArrays
+) -> tuple[bool, float]:
     """(whether the end is reached, the cut after them): the robots at places ``start`` to ``stop`` of
     ``order`` take their pieces at ``finish``, the spiral cut at ``cut`` before them."""
     first, positions, points, along, overlap, allowance = walk
@@ -174,14 +171,14 @@ def _walk(order: np.ndarray, start: int, stop: int, cut: float, finish: float, w
 
 
 @njit(cache=True)
-def _bisected(order: np.ndarray, low: float, high: float, halvings: int, give_up_at: float, walk: WalkArrays) -> float:
+def bisected(order: np.ndarray, low: float, high: float, halvings: int, give_up_at: float, walk: WalkArrays) -> float:
     """The least finish of ``order`` in (low, high], to ``halvings`` halvings of the bracket; once its low end
     reaches ``give_up_at``, the bracket's high end as it is (then above ``give_up_at``)."""
     for _ in range(halvings):
         if low >= give_up_at:
             break
         finish = 0.5 * (low + high)
-        reached, _ = _walk(order, 0, len(order), 0.0, finish, walk)
+        reached, _ = walk_pieces(order, 0, len(order), 0.0, finish, walk)
         if reached:
             high = finish
         else:
@@ -211,137 +208,3 @@ def cuts_for(order: np.ndarray, finish: float, positions: np.ndarray, spiral: Sp
             pieces.append((int(robot), min(cut, spiral.length), min(end, spiral.length)))
         cut = end
     return pieces
-
-
-def neighbours(order: np.ndarray) -> np.ndarray:
-    """Every order one swap of two robots, or one move of a robot to another place, from ``order``: the
-    swaps (i, j), i < j, then the moves of place i to place j, |i - j| > 1 (to i +- 1 is a swap)."""
-    return order[_neighbour_places(len(order))]
-
-
-@functools.cache
-def _neighbour_places(agents: int) -> np.ndarray:
-    """:func:`neighbours` as places: row r holds, for each place, which place of the order it takes (built
-    whole, not row by row: N = 100 has 14,650 rows)."""
-    place = np.arange(agents)
-    i, j = np.triu_indices(agents, k=1)  # the swaps, (i, j) in row-major order
-    swaps = np.where(place == i[:, None], j[:, None], np.where(place == j[:, None], i[:, None], place))
-    i, j = (grid.ravel() for grid in np.meshgrid(place, place, indexing="ij"))
-    keep = np.abs(j - i) > 1
-    i, j = i[keep, None], j[keep, None]  # the moves of place i to place j: the rest close up, i goes in at j
-    later = (place >= i) & (place < j)  # moved later: the places from i up to j take the next one's
-    earlier = (place > j) & (place <= i)  # moved earlier: the places after j up to i take the one before's
-    moves = np.where(place == j, i, np.where(later, place + 1, np.where(earlier, place - 1, place)))
-    return np.ascontiguousarray(np.vstack([swaps, moves]), dtype=np.intp).reshape(-1, agents)
-
-
-def improved_order(order: np.ndarray, positions: np.ndarray, spiral: Spiral) -> tuple[np.ndarray, float]:
-    """(order, its finish): from ``order``, the soonest of all its :func:`neighbours` while it finishes
-    sooner (steepest descent, at most :data:`MAX_ROUNDS` rounds; neighbours more than 20 % sooner than the
-    best so far all look alike to the rough bracket, and the first of them is taken). Each round is
-    :func:`_soonest_neighbour`."""
-    order = np.ascontiguousarray(order, dtype=np.intp)
-    walk = walk_arrays(positions, spiral)
-    best = float(order_finishes(order[None, :], positions, spiral)[0])
-    places = _neighbour_places(len(order))
-    moved = _moved_places(len(order))
-    for _ in range(MAX_ROUNDS):
-        if not len(places):
-            break
-        k, rough = _soonest_neighbour(order, places, moved, best, NEIGHBOUR_BISECTIONS, walk)
-        if k < 0 or rough >= best - 1e-9:
-            break
-        candidate = order[places[k]]
-        exact = float(order_finishes(candidate[None, :], positions, spiral)[0])
-        if exact >= best - 1e-9:
-            break
-        order, best = candidate, exact
-    return order, best
-
-
-@functools.cache
-def _moved_places(agents: int) -> tuple[np.ndarray, np.ndarray]:
-    """For each row of :func:`_neighbour_places`, the first and the last place whose robot it changes."""
-    changed = _neighbour_places(agents) != np.arange(agents)
-    first = changed.argmax(axis=1)
-    last = agents - 1 - changed[:, ::-1].argmax(axis=1)
-    return np.ascontiguousarray(first, dtype=np.intp), np.ascontiguousarray(last, dtype=np.intp)
-
-
-@njit(cache=True)
-def _soonest_neighbour(
-    order: np.ndarray,
-    places: np.ndarray,
-    moved: tuple[np.ndarray, np.ndarray],
-    best: float,
-    halvings: int,
-    walk: WalkArrays,
-) -> tuple[int, float]:
-    """(row of ``places``, its rough finish): the first of the neighbours whose rough finish (bisected from
-    within 20 % under ``best``, :func:`order_finishes`' ``below``) is least; (-1, ``best``) if none is
-    under ``best``. The same answer as bisecting every neighbour, at a fraction of the work (N = 100: 14,650
-    neighbours a round): a neighbour's bracket only ever falls below ``best`` if its pieces reach the end at
-    the bracket's last midpoint on the way up, and the finish is monotone in T and in the cut a robot
-    starts from (a later finish, or a later cut, lengthens every piece after it: a piece's entry moves no
-    farther than its cut, so no transit grows faster). So each neighbour is walked at that one T over the
-    places it changes only (``moved``: the first and last of each): the places before are the order's own,
-    walked once, and the order's own places after reach the end from a cut at or above a threshold
-    (:func:`_suffix_thresholds`); a cut within the thresholds' bracket walks on. Only the neighbours that
-    reach are bisected, each given up once its bracket lies above the least found so far (no rough finish
-    below it is left there)."""
-    low, high = 0.8 * best, best
-    for _ in range(halvings):
-        low = 0.5 * (low + high)  # the midpoints of a neighbour that never reaches the end: the last one
-    agents = len(order)
-    cut_before = np.zeros(agents + 1)
-    reached_before = np.zeros(agents + 1, dtype=np.bool_)
-    for k in range(agents):
-        reached, cut = _walk(order, k, k + 1, cut_before[k], low, walk)
-        cut_before[k + 1] = cut
-        reached_before[k + 1] = reached_before[k] or reached
-    fails_up_to, reaches_from = _suffix_thresholds(order, low, walk)
-    soonest, chosen = best, -1
-    neighbour = np.empty(agents, dtype=order.dtype)
-    for m in range(len(places)):
-        for k in range(agents):
-            neighbour[k] = order[places[m, k]]
-        start, after = moved[0][m], moved[1][m] + 1
-        reached = reached_before[start]
-        if not reached:
-            reached, cut = _walk(neighbour, start, after, cut_before[start], low, walk)
-            if not reached and cut > fails_up_to[after]:
-                reached = cut >= reaches_from[after] or _walk(neighbour, after, agents, cut, low, walk)[0]
-        if reached:
-            rough = _bisected(neighbour, 0.8 * best, best, halvings, soonest, walk)
-            if rough < soonest:
-                soonest, chosen = rough, m
-    return chosen, soonest
-
-
-@njit(cache=True)
-def _suffix_thresholds(order: np.ndarray, finish: float, walk: WalkArrays) -> tuple[np.ndarray, np.ndarray]:
-    """(fails_up_to, reaches_from), (N + 1,) each: the robots at places p to N - 1 of ``order``, starting
-    from a cut at most ``fails_up_to[p]``, do not reach the spiral's end at ``finish``; from a cut at least
-    ``reaches_from[p]``, they do (bisected to 60 halvings; both infinite where no cut reaches, and for the
-    empty suffix)."""
-    first, _, _, along, overlap, allowance = walk
-    agents = len(order)
-    fails_up_to = np.full(agents + 1, np.inf)
-    reaches_from = np.full(agents + 1, np.inf)
-    # Any transit is at most the way to the spiral's first point and the spiral, and the overlap.
-    high_cut = 2.0 * along[-1] + allowance + overlap + first.max() + finish + 1.0
-    for p in range(agents):
-        if not _walk(order, p, agents, high_cut, finish, walk)[0]:
-            continue
-        low, high = 0.0, high_cut
-        if _walk(order, p, agents, 0.0, finish, walk)[0]:
-            low, high = -np.inf, 0.0
-        else:
-            for _ in range(60):
-                middle = 0.5 * (low + high)
-                if _walk(order, p, agents, middle, finish, walk)[0]:
-                    high = middle
-                else:
-                    low = middle
-        fails_up_to[p], reaches_from[p] = low, high
-    return fails_up_to, reaches_from

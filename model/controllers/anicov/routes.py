@@ -24,7 +24,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import linear_sum_assignment, minimize_scalar
 
-from model.controllers.anicov.piece_order import Spiral, cuts_for, improved_order, run_up_entries, start_run_ups
+from model.controllers.anicov.order_search import improved_order
+from model.controllers.anicov.piece_order import Spiral, cuts_for, run_up_entries, start_run_ups
 from model.controllers.anicov.route import Route
 from model.paper.metrics import pass_reach, straight_pass_coverage
 from model.paper.polyline import path_between
@@ -185,7 +186,7 @@ def ordered_routes(
     centre_leads: float = CENTRE_ALLOWANCE_LEADS,
 ) -> tuple[list[np.ndarray], float]:
     """Routes on ``spiral`` for a team (N > 1) with the best order near ``order``
-    (:func:`model.controllers.anicov.piece_order.improved_order`) and its finish: the pieces cut so that each takes its robot
+    (:func:`model.controllers.anicov.order_search.improved_order`) and its finish: the pieces cut so that each takes its robot
     the same time, each after the first entered :data:`SEAM_OVERLAP` back along the spiral. A robot left
     without a piece (its transit alone too long, or after the spiral's end is reached) has a route of its
     own position and takes passes from the start; one sharing the centre's allowance

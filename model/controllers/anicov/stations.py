@@ -41,7 +41,8 @@ from scipy.optimize import linprog
 from scipy.sparse import csc_matrix
 
 from model.controllers.anicov.deposit import Deposit
-from model.controllers.anicov.piece_order import Spiral, cuts_for, improved_order, order_finishes
+from model.controllers.anicov.order_search import improved_order
+from model.controllers.anicov.piece_order import Spiral, cuts_for, order_finishes
 from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop
 from model.controllers.anicov.routes import ORDERED_VARIANTS
 from model.controllers.anicov.touch_ups import simulate_routes
