@@ -192,14 +192,14 @@ def test_a_robot_goes_all_the_way_to_a_covered_objective_and_looks_from_there():
         assert np.isnan(look).all()
 
 
-def test_on_its_way_to_a_covered_objective_a_robot_stops_for_an_uncovered_cell_within_r_less_a_cell():
+def test_on_its_way_to_a_covered_objective_a_robot_stops_for_an_uncovered_cell_within_half_r():
     # Driving on past what it was sent to see cost the drawn office map (N = 10, occlusion) 9 % of its time.
     coverage = one_uncovered_cell(10, 14)
-    objective = (11.5, 10.5)  # covered; the uncovered cell (14.5, 10.5) lies 2.2 from a robot at 12.3
+    objective = (11.5, 10.5)  # covered; the uncovered cell (14.5, 10.5) lies 1.8 from a robot at 12.7, within R/2 = 2
     open_ground = ground_of(np.zeros((20, 20), dtype=bool))
     look = no_look()
     u_glo, theta = global_law_among_walls(
-        coverage, TARGET, 12.3, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, open_ground, np.zeros((20, 20)),
+        coverage, TARGET, 12.7, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, open_ground, np.zeros((20, 20)),
         np.zeros((0, 2)), look,
     )  # fmt: skip
     assert u_glo == 0.0 and theta == pytest.approx(0.0) and tuple(look) == (14.5, 10.5)
@@ -208,14 +208,14 @@ def test_on_its_way_to_a_covered_objective_a_robot_stops_for_an_uncovered_cell_w
     walled = ground_of(occupied)
     look = no_look()
     u_glo, theta = global_law_among_walls(
-        coverage, TARGET, 12.3, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, walled, np.zeros((20, 20)),
+        coverage, TARGET, 12.7, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, walled, np.zeros((20, 20)),
         np.zeros((0, 2)), look,
     )  # fmt: skip
     assert u_glo > 0.0 and theta == pytest.approx(math.pi) and np.isnan(look).all()
-    beyond = one_uncovered_cell(10, 15)  # 3.2 away: beyond R less a cell (3), within R
+    beyond = one_uncovered_cell(10, 15)  # 2.8 away: beyond R/2, within R less a cell (3)
     look = no_look()
     u_glo, _ = global_law_among_walls(
-        beyond, TARGET, 12.3, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, open_ground, np.zeros((20, 20)),
+        beyond, TARGET, 12.7, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, open_ground, np.zeros((20, 20)),
         np.zeros((0, 2)), look,
     )  # fmt: skip
     assert u_glo > 0.0 and np.isnan(look).all()
