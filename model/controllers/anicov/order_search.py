@@ -61,7 +61,7 @@ def improved_order(order: np.ndarray, positions: np.ndarray, spiral: Spiral) -> 
     walk = walk_arrays(positions, spiral)
     best = float(order_finishes(order[None, :], positions, spiral)[0])
     places = _neighbour_places(len(order))
-    moved = _moved_places(len(order))
+    moved = (*_moved_places(len(order)), _later_moves(len(order)))
     for _ in range(MAX_ROUNDS):
         if not len(places):
             break
@@ -85,11 +85,25 @@ def _moved_places(agents: int) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(first, dtype=np.intp), np.ascontiguousarray(last, dtype=np.intp)
 
 
+@functools.cache
+def _later_moves(agents: int) -> np.ndarray:
+    """(N, N): the row of :func:`_neighbour_places` that moves place i later, to place j (j > i + 1); -1
+    elsewhere."""
+    place = np.arange(agents)
+    i, j = (grid.ravel() for grid in np.meshgrid(place, place, indexing="ij"))
+    moves = np.abs(j - i) > 1
+    rows = agents * (agents - 1) // 2 + np.arange(int(moves.sum()))  # the moves come after the swaps
+    i, j = i[moves], j[moves]
+    later = np.full((agents, agents), -1, dtype=np.intp)
+    later[i[j > i], j[j > i]] = rows[j > i]
+    return later
+
+
 @njit(cache=True)
 def _soonest_neighbour(
     order: np.ndarray,
     places: np.ndarray,
-    moved: tuple[np.ndarray, np.ndarray],
+    moved: tuple[np.ndarray, np.ndarray, np.ndarray],
     best: float,
     halvings: int,
     walk: WalkArrays,
@@ -98,43 +112,112 @@ def _soonest_neighbour(
     within 20 % under ``best``, :func:`order_finishes`' ``below``) is least; (-1, ``best``) if none is
     under ``best``. The same answer as bisecting every neighbour, at a fraction of the work (N = 100: 14,650
     neighbours a round): a neighbour's bracket only ever falls below ``best`` if its pieces reach the end at
-    the bracket's last midpoint on the way up, and the finish is monotone in T and in the cut a robot
-    starts from (a later finish, or a later cut, lengthens every piece after it: a piece's entry moves no
-    farther than its cut, so no transit grows faster). So each neighbour is walked at that one T over the
-    places it changes only (``moved``: the first and last of each): the places before are the order's own,
-    walked once, and the order's own places after reach the end from a cut at or above a threshold
-    (:func:`_suffix_thresholds`); a cut within the thresholds' bracket walks on. Only the neighbours that
-    reach are bisected, each given up once its bracket lies above the least found so far (no rough finish
-    below it is left there)."""
+    the bracket's last midpoint on the way up (:func:`_reaching_at`), and the finish is monotone in T. Only
+    the neighbours that reach there are bisected, each given up once its bracket lies above the least found
+    so far (no rough finish below it is left there)."""
     rising = np.empty(halvings)  # the midpoints of a neighbour that fails at each: its bracket's low ends
     low = 0.8 * best
     for k in range(halvings):
         low = rising[k] = 0.5 * (low + best)
+    soonest, chosen = best, -1
+    for m in np.flatnonzero(_reaching_at(order, places, moved, low, walk)):
+        rough = _rough_finish(order[places[m]], rising, best, soonest, walk)
+        if rough < soonest:
+            soonest, chosen = rough, m
+    return chosen, soonest
+
+
+@njit(cache=True)
+def _reaching_at(
+    order: np.ndarray,
+    places: np.ndarray,
+    moved: tuple[np.ndarray, np.ndarray, np.ndarray],
+    finish: float,
+    walk: WalkArrays,
+) -> np.ndarray:
+    """(M,): whether each neighbour's pieces reach the spiral's end at ``finish``. The finish is monotone in
+    the cut a robot starts from too (a later cut lengthens every piece after it: a piece's entry moves no
+    farther than its cut, so no transit grows faster). So a neighbour is walked over the places it changes
+    only (``moved``: the first and last of each, and :func:`_later_moves`): the places before are the
+    order's own, walked once, and the order's own places after reach the end from a cut at or above a
+    threshold (:func:`_suffix_thresholds`); a cut within the thresholds' bracket walks on. The moves of a
+    place to a later one share their walk (:func:`_later_moves_reaching`)."""
     agents = len(order)
     cut_before = np.zeros(agents + 1)
     reached_before = np.zeros(agents + 1, dtype=np.bool_)
     for k in range(agents):
-        reached, cut = walk_pieces(order, k, k + 1, cut_before[k], low, walk)
+        reached, cut = walk_pieces(order, k, k + 1, cut_before[k], finish, walk)
         cut_before[k + 1] = cut
         reached_before[k + 1] = reached_before[k] or reached
-    fails_up_to, reaches_from = _suffix_thresholds(order, low, walk)
-    soonest, chosen = best, -1
+    thresholds = _suffix_thresholds(order, finish, walk)
+    reaching = np.zeros(len(places), dtype=np.bool_)
+    known = _later_moves_reaching(order, moved[2], finish, (cut_before, reached_before), thresholds, walk, reaching)
     neighbour = order.copy()  # a neighbour is the order but for the places it changes
     for m in range(len(places)):
+        if known[m]:
+            continue
         start, after = moved[0][m], moved[1][m] + 1
         for k in range(start, after):
             neighbour[k] = order[places[m, k]]
         reached = reached_before[start]
         if not reached:
-            reached, cut = walk_pieces(neighbour, start, after, cut_before[start], low, walk)
-            if not reached and cut > fails_up_to[after]:
-                reached = cut >= reaches_from[after] or walk_pieces(neighbour, after, agents, cut, low, walk)[0]
-        if reached:
-            rough = _rough_finish(neighbour, rising, best, soonest, walk)
-            if rough < soonest:
-                soonest, chosen = rough, m
+            reached, cut = walk_pieces(neighbour, start, after, cut_before[start], finish, walk)
+            reached = reached or _reaches_from(order, after, cut, finish, thresholds, walk)
+        reaching[m] = reached
         neighbour[start:after] = order[start:after]
-    return chosen, soonest
+    return reaching
+
+
+@njit(cache=True)
+def _reaches_from(
+    order: np.ndarray,
+    place: int,
+    cut: float,
+    finish: float,
+    thresholds: tuple[np.ndarray, np.ndarray],
+    walk: WalkArrays,
+) -> bool:
+    """Whether the order's own robots from ``place`` on, from ``cut``, reach the end at ``finish``: by the
+    thresholds (``fails_up_to``, ``reaches_from``) of :func:`_suffix_thresholds`, else walked."""
+    fails_up_to, reaches_from = thresholds
+    if cut <= fails_up_to[place]:
+        return False
+    return cut >= reaches_from[place] or walk_pieces(order, place, len(order), cut, finish, walk)[0]
+
+
+@njit(cache=True)
+def _later_moves_reaching(
+    order: np.ndarray,
+    later: np.ndarray,
+    finish: float,
+    prefix: tuple[np.ndarray, np.ndarray],
+    thresholds: tuple[np.ndarray, np.ndarray],
+    walk: WalkArrays,
+    reaching: np.ndarray,
+) -> np.ndarray:
+    """:func:`_reaching_at` for the moves of a place i to a later place j (``later``, :func:`_later_moves`),
+    written into ``reaching``; returns which rows it decided. Such a move puts the order's robots i + 1 to j
+    at places i to j - 1 and robot i at j: for one i and j rising, the walk of the robots before robot i is
+    the last one's and one robot more (``prefix``: the order's cut before each place, and whether it reached
+    before it)."""
+    cut_before, reached_before = prefix
+    agents = len(order)
+    known = np.zeros(len(reaching), dtype=np.bool_)
+    for i in range(agents):
+        cut, reached = cut_before[i], reached_before[i]
+        for j in range(i + 1, agents):
+            if not reached:
+                reached, cut = walk_pieces(order, j, j + 1, cut, finish, walk)  # robot j, at place j - 1
+            m = later[i, j]
+            if m < 0:
+                continue
+            known[m] = True
+            if reached:
+                reaching[m] = True
+                continue
+            at_j, after = walk_pieces(order, i, i + 1, cut, finish, walk)  # robot i, at place j
+            reaching[m] = at_j or _reaches_from(order, j + 1, after, finish, thresholds, walk)
+    return known
 
 
 @njit(cache=True)
