@@ -69,3 +69,21 @@ def test_the_improved_order_is_the_steepest_descent_over_every_neighbours_bisect
     expected_order, expected_finish = _steepest_descent_by_definition(start, positions, cut_on)
     assert order.tolist() == expected_order.tolist() and finish == expected_finish
     assert finish < float(order_finishes(start[None, :], positions, cut_on)[0])  # it did improve
+
+
+def test_a_neighbour_reaching_only_at_the_rounds_last_midpoint_is_not_screened_out_by_a_rounding():
+    # Found in review: reaching is monotone in the cut only in exact arithmetic; screened at the midpoint itself,
+    # the neighbour [2, 1, 0] fell 2e-13 short of a threshold and the search stopped an order early.
+    whole, _ = _spiral()
+    cut_on = Spiral(whole.points, whole.along, LEAD, CENTRE_ALLOWANCE_LEADS * LEAD, SEAM_OVERLAP)
+    positions = np.array(
+        [
+            [42.29697808688391, 74.40145841934383],
+            [23.25254573107513, 108.81010341776836],
+            [34.37588719928026, 81.13119253953674],
+        ]
+    )
+    start = np.array([1, 2, 0])
+    order, finish = improved_order(start, positions, cut_on)
+    expected_order, expected_finish = _steepest_descent_by_definition(start, positions, cut_on)
+    assert order.tolist() == expected_order.tolist() == [2, 1, 0] and finish == expected_finish

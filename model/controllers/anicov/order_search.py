@@ -28,6 +28,12 @@ from model.controllers.anicov.piece_order import (
 
 MAX_ROUNDS = 60
 """Local search rounds at most (a round takes the best of all swaps and moves)."""
+SCREEN_MARGIN = 1e-9
+"""How far above the round's last midpoint, relative to the best finish, neighbours are screened
+(:func:`_soonest_neighbour`): far above a rounding (1e-16), far below a halving's step (1e-5)."""
+THRESHOLD_HALVINGS = 60
+"""Halvings of a threshold's bracket (from twice the spiral's length and more: far below a rounding of the
+cut that matters, so almost no neighbour's cut falls between a place's two thresholds)."""
 
 
 def neighbours(order: np.ndarray) -> np.ndarray:
@@ -114,13 +120,19 @@ def _soonest_neighbour(
     neighbours a round): a neighbour's bracket only ever falls below ``best`` if its pieces reach the end at
     the bracket's last midpoint on the way up (:func:`_reaching_at`), and the finish is monotone in T. Only
     the neighbours that reach there are bisected, each given up once its bracket lies above the least found
-    so far (no rough finish below it is left there)."""
+    so far (no rough finish below it is left there). Screened a hair above that midpoint, by
+    :data:`SCREEN_MARGIN`."""
     rising = np.empty(halvings)  # the midpoints of a neighbour that fails at each: its bracket's low ends
     low = 0.8 * best
     for k in range(halvings):
         low = rising[k] = 0.5 * (low + best)
+    # Screened a hair above that midpoint: the walk is monotone in T and in the cut only in exact arithmetic,
+    # and at the midpoint itself a neighbour that reaches there could fall a rounding short of a threshold
+    # (a team of three, tests/test_order_search.py). Every neighbour screened in is decided by
+    # _rough_finish's own bisection, as before.
+    screen = low + SCREEN_MARGIN * best
     soonest, chosen = best, -1
-    for m in np.flatnonzero(_reaching_at(order, places, moved, low, walk)):
+    for m in np.flatnonzero(_reaching_at(order, places, moved, screen, walk)):
         rough = _rough_finish(order[places[m]], rising, best, soonest, walk)
         if rough < soonest:
             soonest, chosen = rough, m
@@ -135,9 +147,11 @@ def _reaching_at(
     finish: float,
     walk: WalkArrays,
 ) -> np.ndarray:
-    """(M,): whether each neighbour's pieces reach the spiral's end at ``finish``. The finish is monotone in
-    the cut a robot starts from too (a later cut lengthens every piece after it: a piece's entry moves no
-    farther than its cut, so no transit grows faster). So a neighbour is walked over the places it changes
+    """(M,): whether each neighbour's pieces reach the spiral's end at ``finish``. Reaching is monotone in the
+    cut a robot starts from too, in exact arithmetic: the next cut, max(c, c + T - transit), and the reach
+    test, c + T - transit, never fall as c grows (a piece's entry moves no farther along the spiral than
+    the cut, so no transit grows faster; leaving a cut of 0 drops the run-up, which is at least the way to
+    the spiral's first point from its start). So a neighbour is walked over the places it changes
     only (``moved``: the first and last of each, and :func:`_later_moves`): the places before are the
     order's own, walked once, and the order's own places after reach the end from a cut at or above a
     threshold (:func:`_suffix_thresholds`); a cut within the thresholds' bracket walks on. The moves of a
@@ -251,11 +265,6 @@ def _suffix_thresholds(order: np.ndarray, finish: float, walk: WalkArrays) -> tu
         reaches_from[p] = _threshold(order, p, finish, True, high_cut, fails_up_to, reaches_from, walk)
         fails_up_to[p] = _threshold(order, p, finish, False, high_cut, fails_up_to, reaches_from, walk)
     return fails_up_to, reaches_from
-
-
-THRESHOLD_HALVINGS = 60
-"""Halvings of a threshold's bracket (from twice the spiral's length and more: far below a rounding of the
-cut that matters, so almost no neighbour's cut falls between a place's two thresholds)."""
 
 
 @njit(cache=True)

@@ -149,8 +149,9 @@ def _point_at(points: np.ndarray, along: np.ndarray, at: float) -> tuple[float, 
 def walk_pieces(
     order: np.ndarray, start: int, stop: int, cut: float, finish: float, walk: WalkArrays
 ) -> tuple[bool, float]:
-    """(whether the end is reached, the cut after them): the robots at places ``start`` to ``stop`` of
-    ``order`` take their pieces at ``finish``, the spiral cut at ``cut`` before them."""
+    """(whether the end is reached, the cut after them, or before the robot that reaches it): the robots at
+    places ``start`` to ``stop`` of ``order`` take their pieces at ``finish``, the spiral cut at ``cut``
+    before them."""
     first, positions, points, along, overlap, allowance = walk
     length = along[-1]
     for k in range(start, stop):

@@ -85,6 +85,8 @@ class Route:
         ahead along the route, held at the next stop; at a stop, a bearing to face there, that bearing then
         done."""
         stop_at, bearing = (self.stops[0].at, self.stops[0].bearings[0]) if self.stops else (math.nan, 0.0)
+        if lookahead <= 0.0:
+            raise ValueError(f"a carrot's lookahead must be above 0, got {lookahead}")
         x, y = float(position[0]), float(position[1])
         carrot_x, carrot_y, self.progress, faced = carrot_on(
             self.points, self.along, self.progress, stop_at, bearing, x, y, lookahead, face_radius
@@ -163,14 +165,15 @@ def carrot_on(
     ``face_radius`` of it), a point ``face_radius`` / 2 from the robot in ``bearing``, which the law turns
     toward (:func:`model.paper.control.pursuit_law`). A carrot nearer than ``face_radius`` is a bearing the law
     would stand at: at the route's end the route is done (at the next plan); where the route doubles back
-    past the robot, it has come this far, and the carrot is taken from there."""
+    past the robot, it has come this far, and the carrot is taken from there (``lookahead`` > 0, or this
+    would look at the same point for ever: :meth:`Route.carrot` says so)."""
     length = along[-1]
     has_stop = stop_at == stop_at
     if has_stop:
         stop_x, stop_y = point_on(points, along, stop_at)
         if math.sqrt((x - stop_x) * (x - stop_x) + (y - stop_y) * (y - stop_y)) < face_radius:
-            reach = 0.5 * face_radius
-            return x + reach * math.cos(bearing), y + reach * math.sin(bearing), max(progress, stop_at), True
+            offset = 0.5 * face_radius
+            return x + offset * math.cos(bearing), y + offset * math.sin(bearing), max(progress, stop_at), True
     while True:
         ahead = progress + lookahead
         if has_stop:
