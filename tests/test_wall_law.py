@@ -219,3 +219,11 @@ def test_on_its_way_to_a_covered_objective_a_robot_stops_for_an_uncovered_cell_w
         np.zeros((0, 2)), look,
     )  # fmt: skip
     assert u_glo > 0.0 and np.isnan(look).all()
+    tight = np.zeros((20, 20), dtype=bool)
+    tight[11, 12] = True  # a wall square 0.5 from the robot, inside its planning radius: no stop there
+    look = no_look()
+    u_glo, _ = global_law_among_walls(
+        coverage, TARGET, 12.7, 10.5, *objective, -0.3, math.pi, 4.0, 1.0, False, ground_of(tight),
+        np.zeros((20, 20)), np.zeros((0, 2)), look,
+    )  # fmt: skip
+    assert u_glo > 0.0 and np.isnan(look).all()
