@@ -69,20 +69,11 @@ def global_law_among_walls(
         # of a cell (less than the gap to any other cell's centre, so a new viewpoint is always driven to): at
         # exactly half a cell a robot crept across the line and back, turning to the point and to the cell in
         # turn, for 200 time units and more, and covered nothing (issue 34, the lab map, N = 1 seed 24).
-        # On the way, an uncovered cell in clear sight within R/2 (eq. 10's stop, where eq. 2's α is half its
-        # most) stops the robot to look at it: driving on to the point past what it was sent to see cost the
-        # drawn office map, N = 10 with occlusion, 314.6 -> 343.5 of mean t_N, over issue 11's goal; with this
-        # stop 313.4. Within R less a cell instead (318.1 there), the robot stared from afar where α is a tenth
-        # of its most: the campus map's single robots took 20 % longer and 4 of 30 left cells to the watchdog.
-        # Only where the robot stands clear of walls by the planning radius: a stop among the campus's speckle
-        # left a single robot where the filter let it neither turn nor drive (3 of 30 incomplete, one at e_D
-        # 0.60); it drives on there, as before.
+        # On the way there, a cell to stop for (_cell_on_the_way).
         gap = math.hypot(objective_x - x, objective_y - y)
         if gap > (0.75 * cell if look[0] == look[0] else 0.5 * cell):
-            roomy = disk_is_free(ground.wall_grid, x, y, ground.plan_radius, ground.grain, ground.bounded)
-            near = 0.5 * sensing_range if roomy else 0.0
-            look_x, look_y = cell_to_look_at(
-                coverage, target_ticks, ground, teammates, x, y, objective_x, objective_y, near, cell, look
+            look_x, look_y = _cell_on_the_way(
+                coverage, target_ticks, ground, teammates, x, y, objective_x, objective_y, sensing_range, cell, look
             )
             look[0], look[1] = look_x, look_y
             if look_x == look_x:
@@ -102,6 +93,36 @@ def global_law_among_walls(
         # nearer, at eq. 10's speed for this distance taken positive, rather than wait for ever.
         return abs(u_glo), math.atan2(objective_y - y, objective_x - x)
     return 0.0, math.atan2(look_y - y, look_x - x)
+
+
+@njit(cache=True)
+def _cell_on_the_way(
+    coverage: np.ndarray,
+    target_ticks: int,
+    ground: Ground,
+    teammates: np.ndarray,
+    x: float,
+    y: float,
+    objective_x: float,
+    objective_y: float,
+    sensing_range: float,
+    cell: float,
+    look: np.ndarray,
+) -> tuple[float, float]:
+    """The cell a robot on its way to a covered objective stops to look at (NaN: none, drive on): an
+    uncovered cell in clear sight within R/2 (eq. 10's stop, where eq. 2's α is half its most), where the
+    robot stands clear of walls by the planning radius. Driving on to the point past what it was sent to
+    see cost the drawn office map, N = 10 with occlusion, 314.6 -> 343.5 of mean t_N, over issue 11's goal;
+    with this stop 311.8. Within R less a cell instead (318.1 there), robots stared from afar where α is a
+    tenth of its most: the campus map's single robots took 20 % longer and 4 of 30 left cells to the
+    watchdog. Without the room test a stop among the campus's speckle left a single robot where the filter
+    let it neither turn nor drive (e_D 0.60 at the end)."""
+    roomy = disk_is_free(ground.wall_grid, x, y, ground.plan_radius, ground.grain, ground.bounded)
+    if not roomy:
+        return math.nan, math.nan
+    return cell_to_look_at(
+        coverage, target_ticks, ground, teammates, x, y, objective_x, objective_y, 0.5 * sensing_range, cell, look
+    )
 
 
 @njit(cache=True)
