@@ -15,15 +15,17 @@ from model.safety.safety import (
     DEADLOCK_FOUND,
     DEADLOCK_RESOLVED,
     FILTER_CHANGED,
+    KEEPING_RIGHT,
     MEMORY_SIZE,
     PARKED,
     STALE_NEIGHBOUR,
     TEAMMATE,
     filter_command,
 )
-from model.scenario import validate
+from model.scenario import load_scenario, validate
 from model.world.ground import open_ground
 from model.world.world import world_of
+from tests.test_real_maps import REAL, map_of
 
 SCENARIO = validate({"agents": 2, "robot_radius": 0.5, "safety_margin": 0.2})
 SAFETY = safety_parameters(SCENARIO)
@@ -210,3 +212,39 @@ def test_a_wall_keeps_its_barrier(x: float, y: float, theta: float, v_hat: float
     assert abs(v) <= V_MAX + 1e-9 and abs(omega) <= OMEGA_MAX + 1e-9
     after = unicycle_step(x, y, theta, v, omega, WALLED.dt)
     assert wall_gap(after[0], after[1]) >= (1.0 - WALLED_SAFETY.decay) * h - 1e-9
+
+
+def test_a_teammate_held_again_and_again_yields_to_a_robot_hemmed_by_a_wall() -> None:
+    """The lab map's state where two robots stood for the rest of a run (N = 8 seed 19, t = 800): robot 1
+    turns in place with a wall ahead, each turn toward its way swinging its look-ahead point at robot 0's,
+    which drives slowly to its objective next to robot 1. Robot 0's deadlock was "resolved" by keeping right
+    a step after it was found and found again ten steps later, for good; robot 1 never came within 50° of
+    its way. On that relapse robot 0 yields (the lower id), and robot 1 comes to face its way."""
+    map_of(REAL / "uwb-lab.toml")  # fetched, or skipped (failed under CI)
+    scenario = load_scenario(REAL / "uwb-lab.toml").with_overrides(agents=2)
+    ground, safety = world_of(scenario).ground, safety_parameters(scenario)
+    poses = np.array([[10.187, 8.881, -0.902], [10.308, 8.426, -1.355]])  # the run's frame (not the map's)
+    goals = np.array([[10.30, 8.70], [9.90, 8.10]])
+    memory = np.zeros((2, MEMORY_SIZE), dtype=np.int64)
+    flags, least_error, closest = np.zeros(2, dtype=np.int64), math.inf, math.inf
+    for _ in range(1000):
+        commands = []
+        for i in range(2):
+            error = math.remainder(
+                math.atan2(goals[i, 1] - poses[i, 1], goals[i, 0] - poses[i, 0]) - poses[i, 2], math.tau
+            )
+            if i == 0:  # its last stretch, slowly (about 0.03 m/s there, as the run's law)
+                distance = float(np.linalg.norm(goals[i] - poses[i, :2]))
+                v_hat, w_hat = 0.15 * distance * max(0.0, math.cos(error)), scenario.k_omega * error
+            else:  # turning in place to its way (about 1.3 rad/s there, as the run's law)
+                v_hat, w_hat = 0.0, 1.2 * error
+            alone = np.zeros(2), np.zeros(2, dtype=np.int64)  # lockstep poses, both teammates
+            commands.append(filter_command(v_hat, w_hat, i, poses, *alone, ground, scenario.cell, safety, memory[i]))
+            flags[i] |= commands[i][2]
+            if i == 1:
+                least_error = min(least_error, abs(error))
+        poses = np.array([unicycle_step(*poses[i], *commands[i][:2], scenario.dt) for i in range(2)])
+        closest = min(closest, float(np.linalg.norm(poses[0, :2] - poses[1, :2])))
+    assert flags[0] & DEADLOCK_FOUND and flags[0] & KEEPING_RIGHT  # robot 0 kept right, then yielded
+    assert least_error < math.radians(15.0)
+    assert closest >= 2 * safety.radius + safety.margin - 1e-9

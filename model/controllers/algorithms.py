@@ -16,6 +16,7 @@ from model.paper.objectives import BlobObjectives, cell_of, fallback_objective, 
 from model.planning import TeamPlanner, path_lengths
 from model.scenario import Scenario
 from model.world.crowding import spread_shared, team_spacing
+from model.world.detours import without_detours
 from model.world.reachability import viewpoints
 from model.world.world import map_frame_of, viewing_range_of, world_of
 
@@ -67,6 +68,9 @@ class Planner(TeamPlanner):
             self.scenario.cell,
         )
         lengths = path_lengths(world, positions, places)
+        places, moved = without_detours(world, objectives, places, positions, lengths)
+        if moved.any():
+            lengths[:, moved] = path_lengths(world, positions, places[moved])
         held = held_to_their_places(lengths, places, [self.sent.get(agent) for agent in ids], self.scenario.cell)
         choice = assign_objectives(positions, places, held)
         self.sent = {agent: (float(places[j, 0]), float(places[j, 1])) for agent, j in zip(ids, choice, strict=True)}

@@ -69,11 +69,16 @@ DETOUR_STEPS = 100
 YIELD_STEPS = 20
 """Steps a robot yielding to a lower-id teammate drives away from it (2 time units at dt = 0.1)."""
 
-HELD, DETOUR, YIELDING, TURNING, TURNING_OUT = 0, 1, 2, 3, 4
-MEMORY_SIZE = 5
+RELAPSE_STEPS = 3 * STUCK_STEPS
+"""A deadlock found again within this many steps of a detour that kept right and "resolved" it was not
+resolved: the robot yields, whatever the ids (:func:`_deadlock`)."""
+
+HELD, DETOUR, YIELDING, TURNING, TURNING_OUT, RELAPSE = 0, 1, 2, 3, 4, 5
+MEMORY_SIZE = 6
 """A robot's deadlock state (``memory``): steps held so far, steps of the detour under way, whether
-that detour is a yield (1) or keeping right (0), the way (+1 left, −1 right, 0 none) of a turn in
-place taken the long way round (:func:`_other_way`), and whether that turn is a deadlock's way out (1)."""
+that detour is a yield to a lower id (1), a yield whatever the ids (2) or keeping right (0), the way
+(+1 left, −1 right, 0 none) of a turn in place taken the long way round (:func:`_other_way`), whether
+that turn is a deadlock's way out (1), and the steps left in which a deadlock found again is a relapse."""
 
 
 @njit(cache=True)
@@ -101,6 +106,7 @@ def filter_command(
         memory[HELD] = memory[TURNING] = memory[TURNING_OUT] = 0
         return 0.0, 0.0, STALE_NEIGHBOUR
     law_omega = omega_hat  # what FILTER_CHANGED compares with, also when the slide turns the nominal
+    memory[RELAPSE] = max(memory[RELAPSE] - 1, 0)
     pressed = wall_x != 0.0 or wall_y != 0.0
     if not binding and pressed and abs(v_hat) > 0.01 * safety.v_max and abs(v) < HELD_FRACTION * abs(v_hat):
         # Pressed on a wall (the law drives into it and the wall stops it): slide along it (model.safety.wall_slide), in
@@ -156,14 +162,21 @@ def _deadlock(
     """A deadlock found (held STUCK_STEPS): its first step, (v, ω, feasible, flags). A robot turning in place
     yields when its nearest teammate has the lower id; else, its teammate being the one to give way and this
     one still held, it turns the long way round if that way is free (:func:`_other_way`); anything else
-    keeps right (a detour)."""
+    keeps right (a detour).
+
+    A deadlock found again within RELAPSE_STEPS of keeping right "resolved" one is a relapse: the robot
+    yields, whatever the ids. Its teammate may be the one that cannot give way: turning in place with a
+    wall ahead, where each turn toward its goal swings its look-ahead point at this robot's, so that the
+    law's command passes here for a step or two and is held again, for good (issue 34, the lab map at
+    N = 8: two robots stood so for the rest of the run, a cell left unseen behind them)."""
     memory[HELD] = 0
     memory[DETOUR] = 1
     flags = DEADLOCK_FOUND
     turning = abs(v_hat) < safety.lookahead * abs(omega_hat)
-    away_x, away_y = _yield_direction(me, poses, safety)
-    if turning and (away_x != 0.0 or away_y != 0.0):
-        memory[YIELDING] = 1
+    relapse = memory[RELAPSE] > 0
+    away_x, away_y = _yield_direction(me, poses, safety, relapse)
+    if (turning or relapse) and (away_x != 0.0 or away_y != 0.0):
+        memory[YIELDING] = 2 if relapse else 1
         v, omega, feasible = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
         return v, omega, feasible, flags | KEEPING_RIGHT
     if _in_place(v_hat, omega_hat, safety):
@@ -215,7 +228,7 @@ def _other_way(
     if memory[TURNING] == 0:
         if feasible and omega * omega_hat > 0.0 and abs(omega) >= HELD_FRACTION * abs(omega_hat):
             return v, omega, feasible, omega_hat, 0  # it turns as asked
-        away_x, away_y = _yield_direction(me, poses, safety)
+        away_x, away_y = _yield_direction(me, poses, safety, False)
         if away_x == 0.0 and away_y == 0.0:
             return v, omega, feasible, omega_hat, 0  # the teammate, of the higher id, gives way (or none is near)
         v_away, omega_away, feasible_away = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
@@ -281,10 +294,11 @@ def _detour(
     memory: np.ndarray,
 ) -> tuple[float, float, bool, int]:
     """One step of a deadlock's detour: (v, ω, feasible, flags). Yielding drives away from the nearest
-    (lower-id) teammate for YIELD_STEPS in all; keeping right ends once the law's command ``passes`` the
-    filter, or after DETOUR_STEPS."""
-    if memory[YIELDING] == 1:
-        away_x, away_y = _yield_direction(me, poses, safety)
+    (lower-id, or any on a relapse) teammate for YIELD_STEPS in all; keeping right ends once the law's
+    command ``passes`` the filter (opening RELAPSE_STEPS in which the same deadlock found again is a
+    relapse), or after DETOUR_STEPS."""
+    if memory[YIELDING] != 0:
+        away_x, away_y = _yield_direction(me, poses, safety, memory[YIELDING] == 2)
         if memory[DETOUR] >= YIELD_STEPS or (away_x == 0.0 and away_y == 0.0):
             memory[DETOUR] = memory[YIELDING] = 0
             return v, omega, feasible, DEADLOCK_RESOLVED if passes else 0
@@ -292,7 +306,7 @@ def _detour(
         v, omega, feasible = _drive_along(away_x, away_y, me, poses, ages, kinds, ground, cell, safety)
         return v, omega, feasible, KEEPING_RIGHT
     if passes:
-        memory[DETOUR] = 0
+        memory[DETOUR], memory[RELAPSE] = 0, RELAPSE_STEPS
         return v, omega, feasible, DEADLOCK_RESOLVED
     if memory[DETOUR] >= DETOUR_STEPS:
         memory[DETOUR] = 0
@@ -305,9 +319,9 @@ def _detour(
 
 
 @njit(cache=True)
-def _yield_direction(me: int, poses: np.ndarray, safety: SafetyParameters) -> tuple[float, float]:
+def _yield_direction(me: int, poses: np.ndarray, safety: SafetyParameters, any_id: bool) -> tuple[float, float]:
     """The unit vector from the nearest teammate's look-ahead point (within safety_range, centre to centre)
-    to this robot's, when that teammate has the lower id (this robot yields); else (0, 0)."""
+    to this robot's, when that teammate has the lower id or ``any_id`` (this robot yields); else (0, 0)."""
     ahead = safety.lookahead
     x, y, theta = poses[me, 0], poses[me, 1], poses[me, 2]
     px, py = x + ahead * math.cos(theta), y + ahead * math.sin(theta)
@@ -323,7 +337,7 @@ def _yield_direction(me: int, poses: np.ndarray, safety: SafetyParameters) -> tu
         if distance < best:
             nearest, best = j, distance
             away_x, away_y = (dx / distance, dy / distance) if distance > 0.0 else (-math.cos(theta), -math.sin(theta))
-    if nearest < 0 or nearest > me:
+    if nearest < 0 or (nearest > me and not any_id):
         return 0.0, 0.0
     return away_x, away_y
 
