@@ -14,7 +14,7 @@ from __future__ import annotations
 import functools
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from model.controllers.anicov.piece_order import (
     NEIGHBOUR_BISECTIONS,
@@ -139,7 +139,7 @@ def _soonest_neighbour(
     return chosen, soonest
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _reaching_at(
     order: np.ndarray,
     places: np.ndarray,
@@ -166,19 +166,18 @@ def _reaching_at(
     thresholds = _suffix_thresholds(order, finish, walk)
     reaching = np.zeros(len(places), dtype=np.bool_)
     known = _later_moves_reaching(order, moved[2], finish, (cut_before, reached_before), thresholds, walk, reaching)
-    neighbour = order.copy()  # a neighbour is the order but for the places it changes
-    for m in range(len(places)):
+    for m in prange(len(places)):  # each neighbour alone: the same answer on any number of threads
         if known[m]:
             continue
         start, after = moved[0][m], moved[1][m] + 1
-        for k in range(start, after):
-            neighbour[k] = order[places[m, k]]
         reached = reached_before[start]
         if not reached:
+            neighbour = order.copy()  # a neighbour is the order but for the places it changes
+            for k in range(start, after):
+                neighbour[k] = order[places[m, k]]
             reached, cut = walk_pieces(neighbour, start, after, cut_before[start], finish, walk)
             reached = reached or _reaches_from(order, after, cut, finish, thresholds, walk)
         reaching[m] = reached
-        neighbour[start:after] = order[start:after]
     return reaching
 
 
@@ -199,7 +198,7 @@ def _reaches_from(
     return cut >= reaches_from[place] or walk_pieces(order, place, len(order), cut, finish, walk)[0]
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _later_moves_reaching(
     order: np.ndarray,
     later: np.ndarray,
@@ -217,7 +216,7 @@ def _later_moves_reaching(
     cut_before, reached_before = prefix
     agents = len(order)
     known = np.zeros(len(reaching), dtype=np.bool_)
-    for i in range(agents):
+    for i in prange(agents):  # each i writes rows of its own
         cut, reached = cut_before[i], reached_before[i]
         for j in range(i + 1, agents):
             if not reached:
