@@ -75,13 +75,13 @@ def test_every_corpus_map_loads_as_published_cropped_to_what_is_known_in_its_own
 def test_a_short_seeded_run_on_the_lab_map_completes():
     scenario_path = REAL / "uwb-lab.toml"
     map_of(scenario_path)
-    # N = 2, seed 1: 2344.2 time units (t* 519.9), about 3 s (515988f).
+    # N = 2, seed 1: 2173.9 time units (t* 519.9), about 3 s (26611f6).
     result = run_scenario(load_scenario(scenario_path).with_overrides(agents=2, seed=1), record_trace=False)
     assert result.completed, (result.errors[-1], [stall.line(0.2, MapFrame()) for stall in result.stalls])
 
 
 def test_a_team_of_eight_completes_the_campus_map():
-    # N = 8, seed 0: complete at t = 2508.4 (t* 314.8; 515988f), the watchdog never needed, robots kept 2r + s apart and
+    # N = 8, seed 0: complete at t = 2890.7 (t* 314.8; 26611f6), the watchdog never needed, robots kept 2r + s apart and
     # r off every wall.
     scenario_path = REAL / "malaga-campus.toml"
     map_of(scenario_path)
@@ -101,7 +101,7 @@ def test_lockstep_over_zenoh_equals_the_engine_byte_for_byte_on_the_lab_map(tmp_
     (in the map's frame) and summary.json are the engine's, byte for byte."""
     config = lab_config(tmp_path, agents=2, seed=1, max_time=150.0)
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
-    assert engine.returncode == EXIT_INCOMPLETE, engine.stderr  # max_time: 150 of the 2344.2 it needs
+    assert engine.returncode == EXIT_INCOMPLETE, engine.stderr  # max_time: 150 of the 2173.9 it needs
     team = unique_team()
     launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record", team=team))
     assert launched.returncode == EXIT_INCOMPLETE, launched.stderr + launched.stdout
