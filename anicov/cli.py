@@ -11,6 +11,7 @@ import uuid
 from pathlib import Path
 
 from agents import command as agent_command
+from anicov import bound as bound_command
 from coordinator import command as coordinator_command
 from logger import command as logger_command
 from model.scenario import ScenarioError
@@ -237,6 +238,11 @@ def _add_in_process_commands(commands: argparse._SubParsersAction) -> None:
     safety.add_argument("--maps", default="warehouse,office,field", help="shipped maps, N = 4 and 10 (or none)")
     safety.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
     safety.set_defaults(handler=command_safety_study)
+
+    bound = commands.add_parser("bound", help="anicov's stations' bound beside t*_N on a scenario's map (issue 36)")
+    add_scenario_arguments(bound)
+    bound_command.add_arguments(bound)
+    bound.set_defaults(handler=bound_command.main)
 
 
 def _add_sweep(commands: argparse._SubParsersAction) -> None:

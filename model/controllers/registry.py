@@ -26,6 +26,7 @@ import sys
 from pathlib import Path
 
 from model.controllers.anicov import AnicovController
+from model.controllers.anicov.terrain_stations import Programme, programme_among_walls
 from model.controllers.interface import Controller
 from model.controllers.paper import PaperController, PaperEq16Controller, PaperLiteralController
 from model.controllers.zigzag import BoustrophedonController, ZigzagController
@@ -77,6 +78,12 @@ def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParamete
     """The scenario's sensor and compiled law (:meth:`model.controllers.interface.Controller.law`), Λ* in the
     map's ticks."""
     return controller_of(scenario).law(scenario, coverage_map.target_ticks)
+
+
+def stations_programme(scenario: Scenario) -> Programme:
+    """anicov's stations among the scenario's walls and their relaxed programme (``anicov bound``; issue 36,
+    items 1 and 6), whichever controller the scenario names."""
+    return programme_among_walls(scenario)
 
 
 def choices() -> tuple[str, ...]:

@@ -2,8 +2,8 @@
 straight hop between stations; :mod:`model.controllers.anicov.stations`' linear programme is built from them.
 
 Beyond the paper (docs/controller.md). Each is one step of the engine's own sensor
-(:func:`model.world.wedge.sense_wedge_among`, in the open world), so that what the programme counts is what the
-engine would add.
+(:func:`model.world.wedge.sense_wedge_among`, in the open world or past the walls of a given ground), so that
+what the programme counts is what the engine would add.
 """
 
 from __future__ import annotations
@@ -16,18 +16,21 @@ from scipy.sparse import csc_matrix
 
 from model.paper.coverage_map import CoverageMap, add_window
 from model.scenario import Scenario
-from model.world.ground import open_ground
+from model.world.ground import Ground, open_ground
 from model.world.wedge import sense_wedge_among
 
 
 class Deposit:
     """The coverage (in Λ*) a camera adds over the scenario's grid, as the engine's sensor adds it."""
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: Scenario, ground: Ground | None = None, period_steps: int | None = None) -> None:
+        """``ground``: the world's, for stares that walls hide (the open world's if not given); ``period_steps``:
+        the steps of one stare (the scenario's plan period if not given)."""
         self.scenario = scenario
+        self.period_steps = scenario.plan_steps if period_steps is None else period_steps
         self.shape = scenario.grid_shape
         self.target_ticks = CoverageMap(*self.shape, scenario.cell, scenario.lambda_star).target_ticks
-        self.ground, self.nobody = open_ground(), np.zeros((0, 2))
+        self.ground, self.nobody = open_ground() if ground is None else ground, np.zeros((0, 2))
         self.blank = np.zeros(self.shape, dtype=np.int64)  # the map the sensor reads Υ from (not written)
 
     def window(self, x: float, y: float, theta: float) -> tuple[int, int, np.ndarray]:
@@ -45,7 +48,7 @@ class Deposit:
         row0, col0, window = self.window(x, y, theta)
         rows, cols = np.nonzero(window)
         flat = (rows + row0) * self.shape[1] + cols + col0
-        return flat, window[rows, cols] * self.scenario.plan_steps / self.target_ticks
+        return flat, window[rows, cols] * self.period_steps / self.target_ticks
 
     def stare(self, x: float, y: float, theta: float) -> np.ndarray:
         """One plan period facing ``theta`` from (x, y), per cell (Λ*)."""
@@ -57,7 +60,7 @@ class Deposit:
     def stares(self, stations: np.ndarray, angles: np.ndarray) -> csc_matrix:
         """Every station's stare at every angle (cells x stations·angles, Λ*), built sparse: a stare reaches
         a wedge's cells of the domain's."""
-        indices, values, starts = [], [], [0]
+        indices, values, starts = [np.zeros(0, dtype=np.int64)], [np.zeros(0)], [0]  # none at all: an empty matrix
         for x, y in stations:
             for angle in angles:
                 flat, added = self.stare_cells(float(x), float(y), float(angle))
