@@ -43,12 +43,15 @@ ANGLES = 2.0 * math.pi * np.arange(BEARINGS) / BEARINGS
 @dataclass(frozen=True)
 class Programme:
     """The stations among walls (K, 2), their relaxed periods (K, BEARINGS), the coverable cells no stare
-    reaches, and the stares' total time (time units)."""
+    reaches, the stares' total time (time units), and the programme itself: the stares of the coverable cells
+    some stare reaches (rows: those cells' flat indices; columns: station by station, bearing by bearing)."""
 
     stations: np.ndarray
     periods: np.ndarray
     unseen: int
     stare_time: float
+    stares: csc_matrix
+    rows: np.ndarray
 
 
 def stations_among_walls(world: World, spacing: float) -> np.ndarray:
@@ -111,7 +114,7 @@ def _solved(world: World, spacing: float) -> Programme:
     if solved.x is None:
         raise ValueError(f"the stations' programme has no solution: {solved.message}")
     periods = solved.x.reshape(len(stations), BEARINGS)
-    return Programme(stations, periods, unseen, float(periods.sum()) * CARROT_PERIOD)
+    return Programme(stations, periods, unseen, float(periods.sum()) * CARROT_PERIOD, demand.tocsc(), rows)
 
 
 def _with_stations_for_unseen(
