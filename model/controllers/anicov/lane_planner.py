@@ -52,14 +52,17 @@ import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from model.controllers.anicov.route import FACE_RADIUS, Route, Stop, face_radius_of
+from model.controllers.algorithms import blob_targets
+from model.controllers.anicov.route import CARROT_PERIOD, FACE_RADIUS, Route, Stop, face_radius_of
 from model.controllers.anicov.routes import balanced_routes, lead_in
 from model.controllers.anicov.stations import station_routes, with_patched_stops
+from model.controllers.anicov.terrain_lanes import stare_route, terrain_routes
 from model.controllers.anicov.touch_ups import TouchUp, blob_labels, with_touch_ups
 from model.controllers.anicov.weave import sweep_of
-from model.paper.objectives import BlobObjectives
-from model.planning import TeamPlanner
+from model.paper.objectives import BlobObjectives, select_objectives
+from model.planning import TeamPlanner, path_lengths
 from model.scenario import Scenario
+from model.world.world import world_of
 
 LOOKAHEAD = 2.0
 """Distance ahead along the path at which the carrot is put (units)."""
@@ -109,13 +112,17 @@ class LanePlanner(TeamPlanner):
     stared: dict[int, np.ndarray] = field(default_factory=dict)  # stations: each robot's last stare (x, y, Σ Υ)
 
     def __post_init__(self) -> None:
-        self.sweep = sweep_of(self.scenario)
-        self.lead = lead_in(self.scenario, self.spacing)
+        self.terrain = self.scenario.has_terrain
+        # Among walls no pass is flown (the weave's sweep is the open square's), and a strip is a range wide.
+        self.sweep = None if self.terrain else sweep_of(self.scenario)
+        self.lead = 0.0 if self.terrain else lead_in(self.scenario, self.spacing)
+        # Among walls, at the robot's own units: a carrot two plan periods of travel ahead.
+        self.lookahead = 2.0 * CARROT_PERIOD * self.scenario.k_v if self.terrain else LOOKAHEAD
 
     @property
     def spacing(self) -> float:
-        """The rings' spacing (:attr:`model.controllers.anicov.weave.Sweep.spacing`)."""
-        return self.sweep.spacing
+        """The rings' spacing (:attr:`model.controllers.anicov.weave.Sweep.spacing`); among walls, R."""
+        return self.scenario.range if self.sweep is None else self.sweep.spacing
 
     def plan(self, lack: np.ndarray, positions: np.ndarray, members: list[int] | None = None) -> np.ndarray:
         """A carrot (x, y) for every member (default all, in id order), shape (M, 2)."""
@@ -123,21 +130,27 @@ class LanePlanner(TeamPlanner):
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
         if not self.routes:
             start = self._all(ids, positions)
-            sweep = self.sweep
             stops: list[list[Stop]] | None = None
             flown = None
-            if self.scenario.stations:
+            if self.terrain:
+                routes, stops = terrain_routes(self.scenario, start)
+            elif self.scenario.stations:
                 routes, stops, _ = station_routes(self.scenario, start)
                 stops, flown = with_patched_stops(self.scenario, routes, stops, start, LOOKAHEAD)
             else:
+                sweep = self.sweep
+                assert sweep is not None
                 routes = balanced_routes(
                     self.scenario, sweep.spacing, start, self.lead, sweep.reach, sweep.edge, sweep.centre_leads
                 )
-            routes, touch_ups = with_touch_ups(self.scenario, routes, start, LOOKAHEAD, self.spacing, stops, flown)
+            if self.terrain:  # the foresight flies the open world: among walls what is left is met as it comes
+                touch_ups: list[list[TouchUp]] = [[] for _ in routes]
+            else:
+                routes, touch_ups = with_touch_ups(self.scenario, routes, start, LOOKAHEAD, self.spacing, stops, flown)
             for agent, route in zip(range(self.scenario.agents), routes, strict=True):
                 self.routes[agent] = Route.of(route, stops=None if stops is None else stops[agent])
                 self.touch_ups[agent] = touch_ups[agent]
-        window = LOOKAHEAD  # no robot is past the carrot it was given (it slows to stop on it)
+        window = self.lookahead  # no robot is past the carrot it was given (it slows to stop on it)
         free = []
         for index, agent in enumerate(ids):
             route = self.routes[agent]
@@ -145,14 +158,41 @@ class LanePlanner(TeamPlanner):
             route.advance(positions[index], window)
             if route.done():
                 free.append(index)
-        if free:
+        if free and self.terrain:
+            self._give_stares(lack, positions, ids, free)
+        elif free:
             self._give_passes(lack, positions, ids, free)
         face = face_radius_of(self.scenario)
         targets = np.array(
-            [self.routes[agent].carrot(positions[index], LOOKAHEAD, face) for index, agent in enumerate(ids)],
+            [self.routes[agent].carrot(positions[index], self.lookahead, face) for index, agent in enumerate(ids)],
             dtype=np.float64,
         )
         return targets.reshape(-1, 2)
+
+    def _give_stares(self, lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]) -> None:
+        """Among walls, once every route is done: each free robot (in id order) to the blob target (an uncovered
+        cell of one of Algorithm 1's blobs, :func:`model.controllers.algorithms.blob_targets`) nearest it by the
+        free path that no robot took before it, to stand where it sees that cell (:func:`terrain_lanes.stand_for`)
+        and face it; until then, and with nothing left for it, it stays."""
+        for index in free:
+            self.routes[ids[index]] = Route.of(positions[index][None, :], cleanup=True)
+        busy = any(not self.routes[agent].cleanup and not self.routes[agent].done() for agent in ids)
+        if busy or not (lack > 0.0).any():
+            return
+        world = world_of(self.scenario)
+        self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range, by_paths=True)
+        if not len(self.blobs.positions):
+            return
+        targets = blob_targets(self.blobs, lack, self.scenario.cell)
+        taken: set[int] = set()
+        for index in free:
+            order = np.argsort(path_lengths(world, positions[index][None, :], targets)[0], kind="stable")
+            chosen = next((int(k) for k in order if int(k) not in taken), None)
+            if chosen is None:
+                return
+            taken.add(chosen)
+            path, stop = stare_route(world, positions[index], targets[chosen])
+            self.routes[ids[index]] = Route.of(path, cleanup=True, stops=[stop])
 
     def _skip_done_touch_ups(self, agent: int, lack: np.ndarray) -> None:
         """A touch-up (:mod:`model.controllers.anicov.touch_ups`) whose cells are all covered by the time its robot's carrot

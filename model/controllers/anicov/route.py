@@ -28,7 +28,11 @@ station reaches (v = d/dt within one step of it)."""
 def face_radius_of(scenario: Scenario) -> float:
     """:data:`FACE_RADIUS` where the anicov controller's robots stand at stations (its default, ``stations``),
     else 0: the one rule the planner's carrots and the robots' law both read."""
-    return FACE_RADIUS if scenario.stations else 0.0
+    if not scenario.stations:
+        return 0.0
+    if not scenario.has_terrain:
+        return FACE_RADIUS
+    return FACE_RADIUS * scenario.k_v * scenario.dt / 0.1  # among walls, at the robot's units: half a step
 
 
 @dataclass
