@@ -37,7 +37,10 @@ case "$command" in
         scenarios/real/fetch_maps.sh  # the public SLAM maps the tests read (from Debian's registry; not committed)
         "$VENV/bin/ruff" check .
         "$VENV/bin/lint-imports"  # the layout's contracts (pyproject.toml [tool.importlinter])
-        exec "$VENV/bin/python" -m pytest "$@"
+        # On every core, up to 4 (pytest-xdist): every test stands alone (free ports, unique team names and
+        # namespaces), and one process at a time took 11.6 min from a fresh clone on 2 cores, 8.5 on both.
+        # ARGS come after, so `./go test -n 0` runs in one process.
+        exec "$VENV/bin/python" -m pytest -n auto --maxprocesses 4 "$@"
         ;;
     team) setup; exec "$VENV/bin/python" launch_team.py --n 4 "$@" ;;
     run) setup; exec "$VENV/bin/anicov" run "$@" ;;
