@@ -42,8 +42,9 @@ def test_the_tour_s_whole_periods_bring_every_coverable_cell_to_lambda_star(plan
 
 
 def test_the_line_in_time_is_the_hops_at_k_v_and_the_stations_periods(plan):
-    points, along = tour_line(plan, ROOMS.k_v)
+    points, along, arrivals = tour_line(plan, ROOMS.k_v)
     assert (np.diff(along) >= 0.0).all() and along[0] == 0.0
+    assert np.array_equal(points[np.searchsorted(along, arrivals)], plan.stations)  # each reached at its arrival
     hops = sum(float(np.linalg.norm(np.diff(hop, axis=0), axis=1).sum()) for hop in plan.hops)
     stares = sum(len(bearings) for bearings in plan.bearings) * CARROT_PERIOD * ROOMS.k_v
     assert along[-1] == pytest.approx(hops + stares)
@@ -52,7 +53,7 @@ def test_the_line_in_time_is_the_hops_at_k_v_and_the_stations_periods(plan):
 
 def test_the_shares_cut_the_line_and_the_slowest_robot_is_as_soon_as_it_can_be(plan):
     world = world_of(ROOMS)
-    points, along = tour_line(plan, ROOMS.k_v)
+    points, along, _ = tour_line(plan, ROOMS.k_v)
     positions = np.array([[2.5, 2.5], [20.5, 13.5], [6.5, 13.5]])
     shares = tour_shares(world, points, along, positions)
     assert sorted(shares) == [(0.0, along[-1] / 3), (along[-1] / 3, 2 * along[-1] / 3), (2 * along[-1] / 3, along[-1])]

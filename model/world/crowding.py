@@ -21,8 +21,7 @@ import numpy as np
 
 from model.scenario import Scenario
 from model.world.ground import PLANNING_MARGIN
-from model.world.reachability import seers
-from model.world.world import World, viewing_range_of
+from model.world.world import World
 
 
 def team_spacing(scenario: Scenario) -> float:
@@ -82,10 +81,8 @@ def _own_place(
     Nearest the robot, not the target: a helper sent to the seer nearest the blob drove round to the far
     side of the teammate at the blob's viewpoint, in a passage, and the two held each other for good, one
     unable to pass, the other looking at the cell through the first one's body (the campus map, N = 4 seed 12)."""
-    cell, sensing_range = world.scenario.cell, viewing_range_of(world.scenario)
-    row, col = math.floor(target[1] / cell), math.floor(target[0] / cell)
-    centre_x, centre_y = (col + 0.5) * cell, (row + 0.5) * cell  # what coverable means (viewpoints does the same)
-    found = seers(world.wall_grid, world.grain, world.reachable, centre_x, centre_y, sensing_range, cell)
+    cell = world.scenario.cell
+    found = world.seers_of(float(target[0]), float(target[1]))  # what coverable means (viewpoints does the same)
     order = np.argsort(np.hypot(found[:, 1] - position[0], found[:, 2] - position[1]), kind="stable")
     for _, x, y in found[order]:
         if _clear_of(np.array((x, y)), taken, spacing):

@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from model.world.geodesic import distance_fields
-from model.world.reachability import nearest_reachable, seers
+from model.world.reachability import nearest_reachable
 from model.world.world import World, viewing_range_of
 
 DETOUR_RANGES = 2.0
@@ -45,10 +45,7 @@ def without_detours(
     team: tuple[np.ndarray, np.ndarray] | None = None
     # A seer's way plus its gap is at least the straight line from the team to the target (+inf is tried).
     for j in np.flatnonzero(~(shortest - saving <= straight)):
-        x, y = targets[j]
-        row, col = math.floor(y / cell), math.floor(x / cell)
-        found = seers(world.wall_grid, world.grain, world.reachable, (col + 0.5) * cell, (row + 0.5) * cell,
-                      sensing_range, cell)  # fmt: skip
+        found = world.seers_of(float(targets[j, 0]), float(targets[j, 1]))
         rows, cols = np.floor(found[:, 2] / cell).astype(np.int64), np.floor(found[:, 1] / cell).astype(np.int64)
         # A seer saves at most its way round to the place less its gap: only seers across a wall can save enough.
         across = world.field(*places[j])[rows, cols] - found[:, 0] > saving

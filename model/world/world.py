@@ -50,7 +50,7 @@ from model.scenario.terrain import (
 )
 from model.world.geodesic import distance_fields, grid_graph, passable_cells, passage_graph
 from model.world.ground import PLANNING_MARGIN, Ground
-from model.world.reachability import coverable_cells
+from model.world.reachability import coverable_cells, seers
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,6 +115,16 @@ class World:
         cell = self.scenario.cell
         row, col = min(max(math.floor(y / cell), 0), rows - 1), min(max(math.floor(x / cell), 0), cols - 1)
         return self._field(row, col)
+
+    def seers_of(self, x: float, y: float) -> np.ndarray:
+        """The reachable cells that see the centre of the cell about (x, y) (:func:`model.world.reachability.seers`
+        within :func:`viewing_range_of`: what coverable means), (M, 3) rows (gap, centre x, centre y), nearest
+        first."""
+        cell = self.scenario.cell
+        centre_x, centre_y = (math.floor(x / cell) + 0.5) * cell, (math.floor(y / cell) + 0.5) * cell
+        return seers(
+            self.wall_grid, self.grain, self.reachable, centre_x, centre_y, viewing_range_of(self.scenario), cell
+        )
 
     @functools.lru_cache(maxsize=256)  # noqa: B019 - one World per scenario, kept for the process's life
     def _field(self, row: int, col: int) -> np.ndarray:

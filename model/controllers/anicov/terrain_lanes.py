@@ -22,8 +22,8 @@ from model.controllers.anicov.route import CARROT_PERIOD, Stop
 from model.controllers.anicov.terrain_plan import TourPlan, tour_line, tour_plan, tour_shares
 from model.controllers.anicov.terrain_routes import hop_path
 from model.scenario import Scenario
-from model.world.reachability import nearest_reachable, seers
-from model.world.world import World, viewing_range_of, world_of
+from model.world.reachability import nearest_reachable
+from model.world.world import World, world_of
 
 STARE_PERIODS = 4
 """Plan periods a robot sent to a blob's viewpoint faces the blob (a blob left after that gets another)."""
@@ -32,40 +32,27 @@ STARE_PERIODS = 4
 def terrain_routes(scenario: Scenario, positions: np.ndarray) -> tuple[list[np.ndarray], list[list[Stop]]]:
     """Every robot's route (M_i, 2) and its stops, from its position through its share of the tour."""
     world, plan = world_of(scenario), tour_plan(scenario)
-    points, along = tour_line(plan, scenario.k_v)
+    points, along, arrivals = tour_line(plan, scenario.k_v)
     shares = tour_shares(world, points, along, positions)
-    arrive, leave = station_times(plan, scenario.k_v)
     routes, stops = [], []
     for robot, (start, end) in enumerate(shares):
-        route, own = _share(world, plan, (points, along), (arrive, leave), positions[robot], (start, end), scenario)
+        route, own = _share(world, plan, (points, along), arrivals, positions[robot], (start, end), scenario)
         routes.append(route)
         stops.append(own)
     return routes, stops
-
-
-def station_times(plan: TourPlan, k_v: float) -> tuple[np.ndarray, np.ndarray]:
-    """Where along the tour's line (units of k_v travel) each station is reached and left."""
-    period = CARROT_PERIOD * k_v
-    arrive, leave, now = [], [], 0.0
-    for k in range(len(plan.stations)):
-        if k:
-            now += float(np.linalg.norm(np.diff(plan.hops[k - 1], axis=0), axis=1).sum())
-        arrive.append(now)
-        now += len(plan.bearings[k]) * period
-        leave.append(now)
-    return np.array(arrive), np.array(leave)
 
 
 def _share(
     world: World,
     plan: TourPlan,
     line: tuple[np.ndarray, np.ndarray],
-    times: tuple[np.ndarray, np.ndarray],
+    arrivals: np.ndarray,
     position: np.ndarray,
     share: tuple[float, float],
     scenario: Scenario,
 ) -> tuple[np.ndarray, list[Stop]]:
-    """One robot's route and stops for its share (start, end) of the line."""
+    """One robot's route and stops for its share (start, end) of the line (``arrivals``: where along it each
+    station is reached)."""
     points, along = line
     start, end = share
     period = CARROT_PERIOD * scenario.k_v
@@ -81,7 +68,7 @@ def _share(
         k = stations.get(tuple(point))
         if k is None or not plan.bearings[k] or (wanted and wanted[-1][0] == len(route) - 1):
             continue
-        arrive = times[0][k]
+        arrive = arrivals[k]
         low, high = max(0, round((start - arrive) / period)), min(len(plan.bearings[k]), round((end - arrive) / period))
         if high > low:
             wanted.append((len(route) - 1, list(plan.bearings[k][low:high])))
@@ -121,12 +108,9 @@ def stand_for(world: World, position: np.ndarray, target: np.ndarray) -> np.ndar
     (:func:`model.world.reachability.seers`) at a gap between R/4 and R/2 (a camera never sees what it stands
     on, and eq. 2's α falls off toward R), nearest the robot; any seer where none lies so; the nearest
     reachable cell where none sees it."""
-    cell, sensing_range = world.scenario.cell, viewing_range_of(world.scenario)
-    row, col = math.floor(target[1] / cell), math.floor(target[0] / cell)
-    found = seers(world.wall_grid, world.grain, world.reachable, (col + 0.5) * cell, (row + 0.5) * cell,
-                  sensing_range, cell)  # fmt: skip
+    found = world.seers_of(float(target[0]), float(target[1]))
     if not len(found):
-        return nearest_reachable(world.reachable, np.asarray(target, dtype=np.float64)[None, :], cell)[0]
+        return nearest_reachable(world.reachable, np.asarray(target, dtype=np.float64)[None, :], world.scenario.cell)[0]
     mid = (found[:, 0] >= 0.25 * world.scenario.range) & (found[:, 0] <= 0.5 * world.scenario.range)
     pool = found[mid] if mid.any() else found
     nearest = int(np.argmin(np.hypot(pool[:, 1] - position[0], pool[:, 2] - position[1])))

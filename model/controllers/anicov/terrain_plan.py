@@ -66,25 +66,27 @@ def _heading(a: np.ndarray, b: np.ndarray) -> float:
     return math.atan2(float(b[1] - a[1]), float(b[0] - a[0]))
 
 
-def tour_line(plan: TourPlan, k_v: float) -> tuple[np.ndarray, np.ndarray]:
-    """(points (M, 2), along (M,)): the tour as a line in time, in units of k_v travel: each hop's legs, each
-    station's point at its arrival and again when its periods are done."""
+def tour_line(plan: TourPlan, k_v: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(points (M, 2), along (M,), arrivals (K,)): the tour as a line in time, in units of k_v travel (each
+    hop's legs, each station's point at its arrival and again when its periods are done), and where along it
+    each station is reached."""
     period = CARROT_PERIOD * k_v
-    points, along, now = [], [], 0.0
+    points, along, arrivals, now = [], [], [], 0.0
     for k, station in enumerate(plan.stations):
         if k:
-            for a, b in zip(plan.hops[k - 1][:-1], plan.hops[k - 1][1:], strict=True):
+            for a, b in itertools.pairwise(plan.hops[k - 1]):
                 now += float(np.linalg.norm(b - a))
                 points.append(b)
                 along.append(now)
         else:
             points.append(station)
             along.append(now)
+        arrivals.append(now)
         if plan.bearings[k]:
             now += len(plan.bearings[k]) * period
             points.append(station)
             along.append(now)
-    return np.array(points, dtype=np.float64).reshape(-1, 2), np.array(along)
+    return np.array(points, dtype=np.float64).reshape(-1, 2), np.array(along), np.array(arrivals)
 
 
 def tour_shares(

@@ -15,12 +15,13 @@ items 1 and 6; docs/controller.md).
 - **The programme**: the least periods of stares that bring every coverable cell to Λ*, relaxed (periods
   need not be whole) and with the hops left out (no order among walls is chosen here): its stare time,
   divided by N, is the time this sensor needs on this map from these stations if the stares were shared
-  perfectly and nobody travelled (:func:`stare_bound`). On the open square it sits beside t*_N
+  perfectly and nobody travelled (``anicov bound`` prints it). On the open square it sits beside t*_N
   (docs/controller.md has both).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -34,8 +35,7 @@ from model.controllers.anicov.deposit import Deposit
 from model.controllers.anicov.route import CARROT_PERIOD
 from model.controllers.anicov.stations import BEARINGS, MARGIN_PER_RANGE, SPACINGS_PER_RANGE, grid
 from model.scenario import Scenario
-from model.world.reachability import seers
-from model.world.world import World, viewing_range_of, world_of
+from model.world.world import World, world_of
 
 ANGLES = 2.0 * math.pi * np.arange(BEARINGS) / BEARINGS
 
@@ -81,15 +81,10 @@ def programme_among_walls(scenario: Scenario) -> Programme:
     return _programme(_keyed(scenario))
 
 
-def stare_bound(scenario: Scenario) -> float:
-    """The programme's stare time shared by the scenario's N robots (time units): what the stations need at
-    the least, nobody travelling."""
-    return programme_among_walls(scenario).stare_time / scenario.agents
-
-
 def _keyed(scenario: Scenario) -> Scenario:
-    """The scenario with the team, seed and time limit set aside (they do not change the programme)."""
-    return scenario.with_overrides(agents=1, seed=0, max_time=1.0, initial_poses=None)
+    """The scenario with the team, seed and time limit set aside (they do not change the programme), as
+    :func:`model.controllers.anicov.stations.layout` keys its layouts."""
+    return dataclasses.replace(scenario, agents=1, seed=0, max_time=1.0)
 
 
 @functools.cache
@@ -130,8 +125,7 @@ def _with_stations_for_unseen(
     added, blocks, unseen = [], [stares], 0
     while len(waiting):
         row, col = divmod(int(waiting[0]), cols)
-        found = seers(world.wall_grid, world.grain, world.reachable, (col + 0.5) * cell, (row + 0.5) * cell,
-                      viewing_range_of(world.scenario), cell)  # fmt: skip
+        found = world.seers_of((col + 0.5) * cell, (row + 0.5) * cell)
         if len(found):
             station = found[:1, 1:]
             more = deposit.stares(station, ANGLES)
