@@ -53,3 +53,19 @@ def test_hops_are_flown_straight_at_k_v_from_station_to_station():
     stations = np.array([[5.0, 5.0], [15.0, 5.0], [15.0, 20.0]])
     steps = [(5.0 + k * 0.1, 5.0, 0.0) for k in range(100)] + [(15.0, 5.0 + k * 0.1, math.pi / 2) for k in range(150)]
     assert Deposit(scenario).hops(stations) == pytest.approx(flown(scenario, steps))
+
+
+def test_a_sure_stare_is_the_least_of_the_station_s_and_of_eight_points_round_it():
+    from model.world.world import world_of
+    from tests.test_terrain_stations import ROOMS
+
+    deposit = Deposit(ROOMS, world_of(ROOMS).ground, 5)
+    station, angles, spread = np.array([[11.0, 3.5]]), np.array([0.0, math.pi / 4]), 0.3  # beside the wall's end
+    sure = deposit.sure_stares(station, angles, spread).toarray()
+    least = deposit.stares(station, angles).toarray()
+    for way in np.arange(8) * math.pi / 4:
+        near = station + spread * np.array([math.cos(way), math.sin(way)])
+        least = np.minimum(least, deposit.stares(near, angles).toarray())
+    assert np.array_equal(sure, least)
+    assert (sure <= deposit.stares(station, angles).toarray()).all()
+    assert sure.sum() < deposit.stares(station, angles).toarray().sum()  # the wall hides some from some points

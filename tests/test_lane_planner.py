@@ -89,11 +89,12 @@ def test_the_pursuit_law_without_a_weave_is_pure_pursuit(x, y, theta, goal_x, go
     assert omega == e_theta
 
 
-def test_best_names_the_anicov_controller_which_knows_no_walls_and_plans_centrally():
+def test_best_names_the_anicov_controller_which_flies_stations_among_walls_and_plans_centrally():
     assert PAPER.with_overrides(controller="best").controller == "anicov"
     assert PAPER.with_overrides(controller="anicov").plan_steps == 5  # a carrot every 0.5 time units
-    with pytest.raises(ScenarioError, match="'controller': 'anicov' knows no walls or robot bodies"):
-        PAPER.with_overrides(controller="anicov", robot_radius=0.5)
+    assert PAPER.with_overrides(controller="anicov", robot_radius=0.5, stations=True).has_terrain
+    with pytest.raises(ScenarioError, match="'stations': false flies anicov's weaving spiral, which knows no walls"):
+        PAPER.with_overrides(controller="anicov", robot_radius=0.5, stations=False)
     with pytest.raises(ScenarioError, match="'planning'"):
         PAPER.with_overrides(controller="anicov", planning="local")
 

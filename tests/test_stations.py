@@ -207,3 +207,14 @@ def test_layouts_are_shared_by_every_team_seed_and_time_limit_of_a_domain():
     first = layout(paper(4), by_columns=True)
     assert layout(dataclasses.replace(paper(10), seed=7, max_time=50.0), by_columns=True) is first
     assert layout(paper(4).with_overrides(range=18.0), by_columns=True) is not first  # another sensor
+
+
+def test_turning_in_puts_the_turn_from_the_way_in_before_the_first_stare_and_only_when_asked():
+    periods = np.zeros(BEARINGS)
+    periods[12] = 2  # facing pi
+    plain = bearing_sequence(periods, 0.0, None, math.pi / 2)
+    assert plain == [math.pi, math.pi]
+    turned = bearing_sequence(periods, 0.0, None, math.pi / 2, turn_in=True)
+    assert turned[-2:] == [math.pi, math.pi] and len(turned) == 3  # one period turning: half way round
+    assert abs(math.remainder(turned[0], 2 * math.pi)) == pytest.approx(math.pi / 2)
+    assert bearing_sequence(periods, math.pi, None, math.pi / 2, turn_in=True) == plain  # already facing it

@@ -1,21 +1,21 @@
 """model.controllers.anicov.terrain_lanes and the LanePlanner among walls: every robot's route starts where it
-stands and drives on legs the disk can make, the stops share out the tour's periods exactly, and a robot sent
-to an uncovered cell stands where it sees it. (anicov still refuses maps in a scenario: these reach the
-planner directly.)"""
+stands and drives on legs the disk can make, the stops share out the tour's periods exactly, and a sharp corner
+is turned in place."""
 
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
+import pytest
 
 from model.controllers.anicov.lane_planner import LanePlanner
-from model.controllers.anicov.route import FACE_RADIUS, face_radius_of
-from model.controllers.anicov.terrain_lanes import stand_for, terrain_routes
+from model.controllers.anicov.route import FACE_RADIUS, Route, arrive_radius_of, face_radius_of
+from model.controllers.anicov.terrain_lanes import corner_turns, terrain_routes
 from model.controllers.anicov.terrain_plan import tour_plan
 from model.scenario import validate
 from model.world.geodesic import in_sight
-from model.world.visibility import segment_crosses_occupied
 from model.world.world import world_of
 from tests.test_terrain_stations import ROOMS
 
@@ -34,22 +34,25 @@ def test_every_route_starts_at_its_robot_and_drives_on_legs_the_disk_can_make():
 
 
 def test_the_stops_share_out_every_period_of_the_tour():
-    _, stops = terrain_routes(ROOMS, POSITIONS)
-    given = sum(len(stop.bearings) for own in stops for stop in own)
+    routes, stops = terrain_routes(ROOMS, POSITIONS)
+    stations = {tuple(station) for station in tour_plan(ROOMS).stations}
+    given = 0
+    for route, own in zip(routes, stops, strict=True):
+        flown = Route.of(route, stops=own)
+        given += sum(len(stop.bearings) for stop in own if tuple(flown.point_at(stop.at)) in stations)
     assert given == sum(len(bearings) for bearings in tour_plan(ROOMS).bearings)
     for own in stops:  # in route order
         assert all(a.at <= b.at for a, b in itertools.pairwise(own))
 
 
-def test_a_robot_sent_to_a_cell_stands_where_it_sees_it_neither_on_it_nor_at_the_rim():
-    world = world_of(ROOMS)
-    target = np.array([18.5, 3.5])
-    place = stand_for(world, np.array([2.5, 2.5]), target)
-    gap = float(np.linalg.norm(place - target))
-    assert ROOMS.range / 4 <= gap <= ROOMS.range / 2
-    col, row = (place / ROOMS.cell).astype(int)
-    assert world.reachable[row, col]
-    assert not segment_crosses_occupied(world.wall_grid, place[0], place[1], target[0], target[1], world.grain)
+def test_a_sharp_corner_is_turned_in_place_a_period_at_a_time_and_a_station_or_a_gentle_bend_is_not():
+    points = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [5.0, 8.0], [9.0, 8.0]])
+    turns = corner_turns(points, {3}, ROOMS)  # point 3 (a 76 degree turn) is a station: its own stop turns it
+    per_period = np.pi * ROOMS.k_omega * 0.5
+    assert [index for index, _ in turns] == [1]  # point 2 bends by 14 degrees: driven round
+    bearings = turns[0][1]
+    assert len(bearings) == math.ceil((np.pi / 2) / per_period - 1e-9)
+    assert bearings[-1] == pytest.approx(np.pi / 2)  # the last faces the next leg
 
 
 def test_the_first_plan_among_walls_gives_each_robot_a_carrot_on_its_route():
@@ -63,7 +66,11 @@ def test_the_first_plan_among_walls_gives_each_robot_a_carrot_on_its_route():
     assert planner.lookahead == 2.0 * 0.5 * ROOMS.k_v
 
 
-def test_the_face_radius_is_the_open_square_s_there_and_half_a_step_among_walls():
-    assert face_radius_of(validate({"controller": "anicov"})) == FACE_RADIUS
-    slow = ROOMS.with_overrides(k_v=0.22)
+def test_the_face_radius_is_the_open_square_s_there_and_half_a_step_among_walls_where_arrival_is_wider():
+    square = validate({"controller": "anicov"})
+    assert face_radius_of(square) == arrive_radius_of(square) == FACE_RADIUS
+    slow = ROOMS.with_overrides(k_v=0.22, controller="anicov")
     assert face_radius_of(slow) == FACE_RADIUS * 0.22 * slow.dt / 0.1
+    assert arrive_radius_of(slow) == 0.22 * slow.dt  # a step: within a sixteenth of the 1.0 cell
+    fine = slow.with_overrides(cell=0.25, domain=[24.0, 16.0])
+    assert arrive_radius_of(fine) == 0.25 / 16

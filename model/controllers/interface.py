@@ -94,6 +94,11 @@ class Controller:
         """A fresh planner for one run (it may keep state between plans)."""
         return Planner(scenario)
 
+    def refuses(self, scenario: Scenario) -> str | None:
+        """Why this controller cannot run a scenario its :attr:`supports` admit (naming the key and what it
+        expects), or None (the default)."""
+        return None
+
     def plan_steps(self, scenario: Scenario) -> int:
         """Steps between two plans (default: ``replan_period``'s)."""
         return scenario.replan_steps

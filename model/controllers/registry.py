@@ -100,6 +100,9 @@ def check_supports(scenario: Scenario) -> str | None:
             f"scenario key 'controller': '{scenario.controller}' knows no walls or robot bodies; with map, obstacles "
             f"or robot_radius use one that does: {', '.join(_names_supporting('terrain'))}"
         )
+    refused = controller.refuses(scenario)
+    if refused is not None:
+        return refused
     if scenario.planning == "local" and not supports.local_planning:
         return (
             f"scenario key 'planning': 'local' runs the planner on each robot; controller '{scenario.controller}' "

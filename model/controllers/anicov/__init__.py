@@ -1,7 +1,8 @@
 """anicov's own controller (docs/controller.md): robots stand at stations and turn their camera through
 bearings chosen by a linear programme, hopping between them (``stations = false``: a weaving spiral then
-passes over what is left), steered by a carrot every :data:`route.CARROT_PERIOD`. Its paths know no walls
-or robot bodies yet, and its routes are cut for the whole team at once (no local planning)."""
+passes over what is left), steered by a carrot every :data:`route.CARROT_PERIOD`. Among walls and with robot
+bodies it flies stations only (:mod:`model.controllers.anicov.terrain_plan` and what follows it); its routes
+are cut for the whole team at once (no local planning)."""
 
 from __future__ import annotations
 
@@ -20,7 +21,15 @@ class AnicovController(Controller):
     """Stations (or the weaving spiral) planned by :class:`LanePlanner`, flown by pure pursuit."""
 
     name: ClassVar[str] = "anicov"
-    supports: ClassVar[Supports] = Supports(terrain=False, local_planning=False, team=True)
+    supports: ClassVar[Supports] = Supports(terrain=True, local_planning=False, team=True)
+
+    def refuses(self, scenario: Scenario) -> str | None:
+        if scenario.has_terrain and not scenario.stations:
+            return (
+                "scenario key 'stations': false flies anicov's weaving spiral, which knows no walls or robot "
+                "bodies; with map, obstacles or robot_radius use stations = true (the default)"
+            )
+        return None
 
     def planner(self, scenario: Scenario) -> TeamPlanner:
         return LanePlanner(scenario)

@@ -70,6 +70,15 @@ class Deposit:
         shape = (self.shape[0] * self.shape[1], len(stations) * len(angles))
         return csc_matrix((np.concatenate(values), np.concatenate(indices), np.array(starts)), shape=shape)
 
+    def sure_stares(self, stations: np.ndarray, angles: np.ndarray, spread: float) -> csc_matrix:
+        """:meth:`stares`, each cell's the least of the station's and of the eight points ``spread`` from it
+        (every 45°): a robot stands a little off its station (within the face radius), and a cell that a wall
+        hides from one of those points may be hidden from where it stands."""
+        sure = self.stares(stations, angles)
+        for way in np.arange(8) * math.pi / 4:
+            sure = sure.minimum(self.stares(stations + spread * np.array([math.cos(way), math.sin(way)]), angles))
+        return sure.tocsc()
+
     def hops(self, stations: np.ndarray) -> np.ndarray:
         """The hops between consecutive stations flown straight at k_v, per cell (Λ*)."""
         ticks = np.zeros(self.shape, dtype=np.int64)

@@ -52,17 +52,23 @@ import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from model.controllers.algorithms import blob_targets
-from model.controllers.anicov.route import CARROT_PERIOD, FACE_RADIUS, Route, Stop, face_radius_of
+from model.controllers.anicov.route import (
+    CARROT_PERIOD,
+    FACE_RADIUS,
+    Route,
+    Stop,
+    arrive_radius_of,
+    face_radius_of,
+)
 from model.controllers.anicov.routes import balanced_routes, lead_in
 from model.controllers.anicov.stations import station_routes, with_patched_stops
-from model.controllers.anicov.terrain_lanes import stare_route, terrain_routes
+from model.controllers.anicov.terrain_flight import TerrainFlight
+from model.controllers.anicov.terrain_lanes import terrain_routes
 from model.controllers.anicov.touch_ups import TouchUp, blob_labels, with_touch_ups
 from model.controllers.anicov.weave import sweep_of
-from model.paper.objectives import BlobObjectives, select_objectives
-from model.planning import TeamPlanner, path_lengths
+from model.paper.objectives import BlobObjectives
+from model.planning import TeamPlanner
 from model.scenario import Scenario
-from model.world.world import world_of
 
 LOOKAHEAD = 2.0
 """Distance ahead along the path at which the carrot is put (units)."""
@@ -118,6 +124,7 @@ class LanePlanner(TeamPlanner):
         self.lead = 0.0 if self.terrain else lead_in(self.scenario, self.spacing)
         # Among walls, at the robot's own units: a carrot two plan periods of travel ahead.
         self.lookahead = 2.0 * CARROT_PERIOD * self.scenario.k_v if self.terrain else LOOKAHEAD
+        self.flight = TerrainFlight(self.scenario) if self.terrain else None
 
     @property
     def spacing(self) -> float:
@@ -158,41 +165,19 @@ class LanePlanner(TeamPlanner):
             route.advance(positions[index], window)
             if route.done():
                 free.append(index)
-        if free and self.terrain:
-            self._give_stares(lack, positions, ids, free)
+        if self.flight is not None:
+            self.flight.steer(self.routes, lack, positions, ids, free)
         elif free:
             self._give_passes(lack, positions, ids, free)
-        face = face_radius_of(self.scenario)
+        face, arrive = face_radius_of(self.scenario), arrive_radius_of(self.scenario)
         targets = np.array(
-            [self.routes[agent].carrot(positions[index], self.lookahead, face) for index, agent in enumerate(ids)],
+            [
+                self.routes[agent].carrot(positions[index], self.lookahead, face, arrive)
+                for index, agent in enumerate(ids)
+            ],
             dtype=np.float64,
         )
         return targets.reshape(-1, 2)
-
-    def _give_stares(self, lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]) -> None:
-        """Among walls, once every route is done: each free robot (in id order) to the blob target (an uncovered
-        cell of one of Algorithm 1's blobs, :func:`model.controllers.algorithms.blob_targets`) nearest it by the
-        free path that no robot took before it, to stand where it sees that cell (:func:`terrain_lanes.stand_for`)
-        and face it; until then, and with nothing left for it, it stays."""
-        for index in free:
-            self.routes[ids[index]] = Route.of(positions[index][None, :], cleanup=True)
-        busy = any(not self.routes[agent].cleanup and not self.routes[agent].done() for agent in ids)
-        if busy or not (lack > 0.0).any():
-            return
-        world = world_of(self.scenario)
-        self.blobs = select_objectives(lack, self.blobs, self.scenario.cell, self.scenario.range, by_paths=True)
-        if not len(self.blobs.positions):
-            return
-        targets = blob_targets(self.blobs, lack, self.scenario.cell)
-        taken: set[int] = set()
-        for index in free:
-            order = np.argsort(path_lengths(world, positions[index][None, :], targets)[0], kind="stable")
-            chosen = next((int(k) for k in order if int(k) not in taken), None)
-            if chosen is None:
-                return
-            taken.add(chosen)
-            path, stop = stare_route(world, positions[index], targets[chosen])
-            self.routes[ids[index]] = Route.of(path, cleanup=True, stops=[stop])
 
     def _skip_done_touch_ups(self, agent: int, lack: np.ndarray) -> None:
         """A touch-up (:mod:`model.controllers.anicov.touch_ups`) whose cells are all covered by the time its robot's carrot

@@ -113,7 +113,11 @@ def grid(width: float, height: float, spacing: float, margin: float, by_columns:
 
 
 def bearing_sequence(
-    periods: np.ndarray, arrive: float | None = None, leave: float | None = None, turn: float = TURN_PER_PERIOD
+    periods: np.ndarray,
+    arrive: float | None = None,
+    leave: float | None = None,
+    turn: float = TURN_PER_PERIOD,
+    turn_in: bool = False,
 ) -> list[float]:
     """The bearings (radians) to face, one per period, for ``periods`` (BEARINGS,) periods at each: one sweep
     over the bearings needed, from the one after the largest gap between them counterclockwise (or back from
@@ -145,7 +149,17 @@ def bearing_sequence(
     sequence = min(ways, key=lambda way: _turn(arrive, way[0]) + _turn(way[-1], leave))
     if leave is not None and _turn(sequence[-1], leave) > width + 1e-9:
         sequence.append(leave)
+    if turn_in and arrive is not None:
+        sequence = _turning_in(arrive, sequence[0], turn) + sequence
     return sequence
+
+
+def _turning_in(arrive: float, first: float, turn: float) -> list[float]:
+    """The bearings a robot faces while it turns from ``arrive`` to ``first`` at ``turn`` a period, the last
+    period's turn excluded (a stare's period begins facing its bearing, not turning to it)."""
+    gap = math.remainder(first - arrive, 2.0 * math.pi)
+    steps = int(abs(gap) / turn - 1e-9)
+    return [arrive + gap * k / (steps + 1) for k in range(1, steps + 1)]
 
 
 def _turn(a: float | None, b: float | None) -> float:

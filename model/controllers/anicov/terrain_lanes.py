@@ -1,15 +1,13 @@
 """anicov's routes among walls, flown as on the open square (issue 36, items 1 and 2): each robot's share of the
-tour (:mod:`model.controllers.anicov.terrain_plan`) as a route of hops and stops, and what a robot does when
-its route is done.
+tour (:mod:`model.controllers.anicov.terrain_plan`) as a route of hops and stops.
 
 - **A share's route**: the free path from the robot to its share's first point on the line, then the line's
   points within the share (hop legs and stations), with a stop at each station whose periods fall in the
-  share (whole periods, the nearest cut, as on the open square).
-- **When routes are done** and cells are left (the flight is not the programme: robots pass a station a
-  little off, the filter holds them, a stare is cut short), each free robot is sent, as the paper's
-  planner sends robots among walls (Algorithm 1's blobs, their viewpoints, Algorithm 2 on the free paths'
-  lengths), to its blob's viewpoint along the free path, and stares at the blob from there for
-  :data:`STARE_PERIODS` periods; a robot with nothing left for it stays.
+  share (whole periods, the nearest cut, as on the open square), and a turn in place at every sharp corner
+  (:func:`corner_turns`).
+- **A piece's route** (:func:`piece_route`): the same through a cleanup's stations
+  (:mod:`model.controllers.anicov.terrain_cleanup`); what a robot does once its route is done is
+  :mod:`model.controllers.anicov.terrain_flight`'s.
 """
 
 from __future__ import annotations
@@ -19,14 +17,14 @@ import math
 import numpy as np
 
 from model.controllers.anicov.route import CARROT_PERIOD, Stop
-from model.controllers.anicov.terrain_plan import TourPlan, tour_line, tour_plan, tour_shares
+from model.controllers.anicov.terrain_plan import TourPlan, tour_line, tour_of, tour_plan, tour_shares
 from model.controllers.anicov.terrain_routes import hop_path
 from model.scenario import Scenario
 from model.world.reachability import nearest_reachable
 from model.world.world import World, world_of
 
-STARE_PERIODS = 4
-"""Plan periods a robot sent to a blob's viewpoint faces the blob (a blob left after that gets another)."""
+CORNER_TURN = math.radians(30.0)
+"""A route's corner that turns more than this is turned in place (:func:`corner_turns`)."""
 
 
 def terrain_routes(scenario: Scenario, positions: np.ndarray) -> tuple[list[np.ndarray], list[list[Stop]]]:
@@ -40,6 +38,16 @@ def terrain_routes(scenario: Scenario, positions: np.ndarray) -> tuple[list[np.n
         routes.append(route)
         stops.append(own)
     return routes, stops
+
+
+def piece_route(
+    world: World, scenario: Scenario, position: np.ndarray, stations: np.ndarray, periods: np.ndarray
+) -> tuple[np.ndarray, list[Stop]]:
+    """One robot's route and stops from ``position`` through ``stations`` (in this order) and their whole
+    ``periods`` (K, BEARINGS): a cleanup's piece (:func:`model.controllers.anicov.terrain_cleanup.cleanup_pieces`)."""
+    plan = tour_of(world, stations, periods, scenario)
+    points, along, arrivals = tour_line(plan, scenario.k_v)
+    return _share(world, plan, (points, along), arrivals, position, (0.0, float(along[-1])), scenario)
 
 
 def _share(
@@ -74,7 +82,28 @@ def _share(
             wanted.append((len(route) - 1, list(plan.bearings[k][low:high])))
     route_points = np.array(route, dtype=np.float64).reshape(-1, 2)
     lengths = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(route_points, axis=0), axis=1))])
+    wanted = sorted([*wanted, *corner_turns(route_points, {index for index, _ in wanted}, scenario)])
     return route_points, [Stop(float(lengths[index]), bearings) for index, bearings in wanted]
+
+
+def corner_turns(points: np.ndarray, stations: set[int], scenario: Scenario) -> list[tuple[int, list[float]]]:
+    """(point index, bearings): at every inner corner of a route (not a station) that turns more than
+    :data:`CORNER_TURN`, the robot stops and turns in place toward the next leg, a period at a time at the bound
+    π k_ω (the last facing the leg). Driven round it, the pursuit's ω = k_ω e_θ (eq. 16) turns a third as fast
+    as the bound and its speed falls with the heading's error all the while (campus, k_ω = 0.48: a right angle
+    takes about 5 time units of creeping)."""
+    turn = math.pi * scenario.k_omega * CARROT_PERIOD
+    found = []
+    for k in range(1, len(points) - 1):
+        if k in stations:
+            continue
+        before = math.atan2(points[k][1] - points[k - 1][1], points[k][0] - points[k - 1][0])
+        after = math.atan2(points[k + 1][1] - points[k][1], points[k + 1][0] - points[k][0])
+        gap = math.remainder(after - before, 2.0 * math.pi)
+        if abs(gap) > CORNER_TURN:
+            steps = math.ceil(abs(gap) / turn - 1e-9)
+            found.append((k, [before + gap * j / steps for j in range(1, steps + 1)]))
+    return found
 
 
 def free_path(world: World, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
@@ -91,27 +120,3 @@ def free_path(world: World, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     path = hop_path(world, begin, end)
     path = np.vstack([start[None, :], path[1:]]) if not inside else path
     return np.vstack([path, np.asarray(goal)[None, :]]) if not np.allclose(path[-1], goal) else path
-
-
-def stare_route(world: World, position: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, Stop]:
-    """A free robot's way to where it sees the uncovered cell at ``target`` (:func:`stand_for`) and its stop
-    there facing it."""
-    place = stand_for(world, position, target)
-    path = free_path(world, position, place)
-    length = float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum()) if len(path) > 1 else 0.0
-    bearing = math.atan2(float(target[1] - place[1]), float(target[0] - place[0]))
-    return path, Stop(length, [bearing] * STARE_PERIODS)
-
-
-def stand_for(world: World, position: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """Where a robot stands to look at the cell about ``target``: the reachable cell that sees its centre
-    (:func:`model.world.reachability.seers`) at a gap between R/4 and R/2 (a camera never sees what it stands
-    on, and eq. 2's α falls off toward R), nearest the robot; any seer where none lies so; the nearest
-    reachable cell where none sees it."""
-    found = world.seers_of(float(target[0]), float(target[1]))
-    if not len(found):
-        return nearest_reachable(world.reachable, np.asarray(target, dtype=np.float64)[None, :], world.scenario.cell)[0]
-    mid = (found[:, 0] >= 0.25 * world.scenario.range) & (found[:, 0] <= 0.5 * world.scenario.range)
-    pool = found[mid] if mid.any() else found
-    nearest = int(np.argmin(np.hypot(pool[:, 1] - position[0], pool[:, 2] - position[1])))
-    return pool[nearest, 1:].copy()

@@ -51,15 +51,21 @@ def tour_plan(scenario: Scenario) -> TourPlan:
     staring = np.flatnonzero(periods.sum(axis=1) > 0)
     stations = programme.stations[staring]
     order = station_tour(travel_lengths(world, stations))
-    stations, periods = stations[order], periods[staring][order]
+    return tour_of(world, stations[order], periods[staring][order], scenario)
+
+
+def tour_of(world: World, stations: np.ndarray, periods: np.ndarray, scenario: Scenario) -> TourPlan:
+    """The tour over ``stations`` (K, 2) in this order, each with its whole ``periods`` (K, BEARINGS): the hops
+    between them as free paths, and at each its bearings in one sweep, arriving along the hop in and leaving
+    along the hop out."""
     hops = tuple(hop_path(world, a, b) for a, b in itertools.pairwise(stations))
     turn = math.pi * scenario.k_omega * CARROT_PERIOD
     bearings = []
     for k, row in enumerate(periods):
-        arrive = _heading(hops[k - 1][-2], hops[k - 1][-1]) if k else None
-        leave = _heading(hops[k][0], hops[k][1]) if k < len(hops) else None
-        bearings.append(tuple(bearing_sequence(row, arrive, leave, turn)))
-    return TourPlan(stations, tuple(bearings), hops)
+        arrive = _heading(hops[k - 1][-2], hops[k - 1][-1]) if k and len(hops[k - 1]) > 1 else None
+        leave = _heading(hops[k][0], hops[k][1]) if k < len(hops) and len(hops[k]) > 1 else None
+        bearings.append(tuple(bearing_sequence(row, arrive, leave, turn, turn_in=True)))
+    return TourPlan(np.asarray(stations, dtype=np.float64).reshape(-1, 2), tuple(bearings), hops)
 
 
 def _heading(a: np.ndarray, b: np.ndarray) -> float:

@@ -131,7 +131,7 @@ def _fly_route(
         if progress >= length - 1e-6 and stop == len(stop_at):  # Route.done
             break
         carrot_x, carrot_y, progress, turned = carrot_on(
-            points, along, progress, next_stop, bearing, x, y, lookahead, law.face_radius
+            points, along, progress, next_stop, bearing, x, y, lookahead, law.face_radius, law.face_radius
         )
         if turned:
             faced += 1

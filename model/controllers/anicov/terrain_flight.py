@@ -1,0 +1,199 @@
+"""How anicov's robots fly among walls once their routes are cut (issue 36, items 1 and 2): patches as a
+station is left, and the cleanup when a route is done (:mod:`model.controllers.anicov.terrain_cleanup` has the
+programmes).
+
+- **A patch where the robot stands** (:meth:`TerrainFlight.patch`): the moment a robot has faced its station's
+  last bearing, the cells its stares there should have finished may still be short (it stood a little off,
+  turned between bearings, a wall hid a corner). A robot there now pays a few periods for what a cleanup
+  later pays a trip across the map for: the station gets the periods that bring what is left near it to Λ*,
+  where nothing still on anyone's route will stare.
+- **The cleanup**: when a robot's route is done, or every :data:`CLEANUP_RETRY` plans while one waits, the
+  cleanup is planned again for every robot done with its route or still on its way to its cleanup's first
+  station, on what the others will not stare at; a robot given nothing stays. A cleanup route flown to its
+  end that took less than :data:`CLEANUP_PROGRESS` of its cells' Υ has its stations banned from later
+  cleanups (the robot could not stand or face as the stares assume), so that no robot is sent there for ever.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from model.controllers.anicov.deposit import Deposit
+from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop, arrive_radius_of
+from model.controllers.anicov.terrain_cleanup import (
+    cleanup_pieces,
+    cleanup_stations,
+    left_near,
+    residual_lack,
+    station_patch,
+)
+from model.controllers.anicov.terrain_lanes import free_path, piece_route
+from model.controllers.anicov.terrain_relief import relief
+from model.controllers.anicov.terrain_stations import ANGLES
+from model.scenario import Scenario
+from model.world.world import world_of
+
+CLEANUP_RETRY = 4
+"""Plans between two tries at a cleanup while a robot waits with nothing to do (2 time units)."""
+DETOUR_MOST = 2.0
+"""The longest detour (there and back, in R) a robot leaving a station takes to finish what it leaves behind."""
+CLEANUP_PROGRESS = 0.1
+"""The share of its cells' Υ a cleanup route must take away, or its stations are banned."""
+
+
+@dataclass
+class TerrainFlight:
+    """The state of the flight among walls: how many stops each robot had at the last plan and the bearing it
+    was given then, the robots standing with nothing to do, the plans until the cleanup is tried again, each
+    cleaning robot's (station cells, cells its stares reach, their Υ when given), and the banned cells."""
+
+    scenario: Scenario
+    stops_left: dict[int, int] = field(default_factory=dict)
+    facing: dict[int, float] = field(default_factory=dict)
+    patched: dict[int, float] = field(default_factory=dict)  # where a robot's patch stop stands (arc length)
+    detour_ends: dict[int, float] = field(default_factory=dict)  # where a robot's detour rejoins its route
+    idle: set[int] = field(default_factory=set)
+    cleanup_wait: int = 0
+    cleaning: dict[int, tuple[list[tuple[int, int]], np.ndarray, float]] = field(default_factory=dict)
+    banned: set[tuple[int, int]] = field(default_factory=set)
+    deposit: Deposit | None = None
+
+    def steer(
+        self, routes: dict[int, Route], lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]
+    ) -> None:
+        """Before this plan's carrots (after every route's advance): patches, then the cleanup."""
+        for agent in ids:
+            route = routes[agent]
+            if not route.cleanup and len(route.stops) < self.stops_left.get(agent, 0):
+                patch_done = self.patched.pop(agent, None) == route.progress
+                if not patch_done and route.progress > self.detour_ends.get(agent, -1.0):  # nor a detour's stop
+                    self.patch(routes, agent, lack)
+        self.clean_up(routes, lack, positions, ids, free)
+        for agent in ids:
+            route = routes[agent]
+            self.stops_left[agent] = len(route.stops)
+            if route.stops and route.stops[0].bearings:
+                self.facing[agent] = route.stops[0].bearings[0]
+
+    def patch(self, routes: dict[int, Route], agent: int, lack: np.ndarray) -> None:
+        """The robot has just faced its station's last bearing: a stop where it stands with the bearings that
+        finish the cells near it (:func:`terrain_cleanup.station_patch`), if any are left to it."""
+        route = routes[agent]
+        station = route.point_at(route.progress)
+        ahead = route.point_at(route.progress + 2.0 * self.scenario.range)
+        leave = math.atan2(ahead[1] - station[1], ahead[0] - station[0]) if route.progress < route.length else None
+        others = [other for key, other in routes.items() if key != agent] + [route]
+        bearings = station_patch(
+            world_of(self.scenario), self._deposit(), lack, station, others, (self.facing.get(agent), leave)
+        )
+        if bearings:
+            route.stops.insert(0, Stop(route.progress, bearings))
+            self.patched[agent] = route.progress
+        world, deposit = world_of(self.scenario), self._deposit()
+        behind = left_near(world, deposit, lack, station, [*others])
+        if not (behind > 0.0).any():
+            return
+        stations, periods = cleanup_stations(world, deposit, behind, frozenset(self.banned))
+        detour = self._detour(route, stations, periods) if len(stations) else None
+        if detour is not None:
+            routes[agent], self.detour_ends[agent] = detour
+            if bearings:
+                self.patched[agent] = 0.0
+
+    def _detour(self, route: Route, stations: np.ndarray, periods: np.ndarray) -> tuple[Route, float] | None:
+        """(``route`` from where it has come with a detour through ``stations`` (their ``periods``) and back to
+        that point first, the detour's length), when that length is at most :data:`DETOUR_MOST` R; else None."""
+        world, scenario = world_of(self.scenario), self.scenario
+        here = route.point_at(route.progress)
+        out, stops = piece_route(world, scenario, here, stations, periods)
+        back = free_path(world, out[-1], here)
+        there = _length(out) + _length(back)
+        if there > DETOUR_MOST * scenario.range:
+            return None
+        rest = np.vstack([here[None, :], route.points[route.along > route.progress]])
+        kept = [Stop(stop.at - route.progress + there, stop.bearings) for stop in route.stops]
+        here_first = [stop for stop in kept if stop.at <= there + 1e-9]  # the patch where it stands: before it goes
+        later = [stop for stop in kept if stop.at > there + 1e-9]
+        here_first = [Stop(0.0, stop.bearings) for stop in here_first]
+        return Route.of(np.vstack([out, back[1:], rest[1:]]), stops=[*here_first, *stops, *later]), there
+
+    def clean_up(
+        self, routes: dict[int, Route], lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]
+    ) -> None:
+        """The cleanup (see the module)."""
+        just_done = [index for index in free if ids[index] not in self.idle]
+        for index in just_done:
+            self._judge(ids[index], lack)
+            routes[ids[index]] = Route.of(positions[index][None, :], cleanup=True)
+            self.idle.add(ids[index])
+        self.cleanup_wait -= 1
+        if not free or not (just_done or self.cleanup_wait <= 0):
+            return
+        self.cleanup_wait = CLEANUP_RETRY
+        for index in free:
+            self._relieve(routes, ids, ids[index], positions[index])
+        free = [index for index in free if ids[index] in self.idle]
+        if not free:
+            return
+        team = [index for index, agent in enumerate(ids) if self._may_recut(routes[agent])]
+        busy = [routes[agent] for index, agent in enumerate(ids) if index not in team]
+        world, deposit = world_of(self.scenario), self._deposit()
+        need = residual_lack(deposit, lack, busy)
+        stations, periods = cleanup_stations(world, deposit, need, frozenset(self.banned))
+        pieces = cleanup_pieces(world, stations, periods, positions[team])
+        for index, (own, own_periods) in zip(team, pieces, strict=True):
+            agent = ids[index]
+            self.cleaning.pop(agent, None)  # cut anew before it was done: not judged
+            if not len(own):
+                routes[agent] = Route.of(positions[index][None, :], cleanup=True)
+                self.idle.add(agent)
+                continue
+            path, stops = piece_route(world, self.scenario, positions[index], own, own_periods)
+            routes[agent] = Route.of(path, cleanup=True, stops=stops)
+            self.idle.discard(agent)
+            reached = np.unique(np.concatenate([deposit.stare_cells(*xy, a)[0] for xy in own for a in ANGLES]))
+            cells = [(int(y // self.scenario.cell), int(x // self.scenario.cell)) for x, y in own]
+            self.cleaning[agent] = (cells, reached, float(lack.ravel()[reached].sum()))
+
+    def _relieve(self, routes: dict[int, Route], ids: list[int], agent: int, position: np.ndarray) -> None:
+        """``agent``, done, takes over the end of the route of the robot with the most left to fly, where that
+        brings the team's end sooner (:func:`terrain_relief.relief`)."""
+        busy = [other for other in ids if not routes[other].cleanup and not routes[other].done()]
+        given = relief(world_of(self.scenario), routes, busy, position)
+        if given is None:
+            return
+        routes[given.relieved], routes[agent] = given.kept, given.taken
+        self.idle.discard(agent)
+        self.patched.pop(agent, None)
+        self.detour_ends.pop(agent, None)
+
+    def _may_recut(self, route: Route) -> bool:
+        """Whether a robot joins the cleanup's next cut: done with its route, or on its way to the first station of
+        its cleanup route (one standing at a station finishes its stares there: cut anew, it would begin them
+        again)."""
+        if route.done():
+            return True
+        first = route.stops[0].at if route.stops else route.length
+        return route.cleanup and route.progress < first - arrive_radius_of(self.scenario)
+
+    def _judge(self, agent: int, lack: np.ndarray) -> None:
+        """Ban the stations of a cleanup route flown to its end that took too little (see the module)."""
+        judged = self.cleaning.pop(agent, None)
+        if judged is None:
+            return
+        cells, reached, before = judged
+        if before > 0.0 and float(lack.ravel()[reached].sum()) > (1.0 - CLEANUP_PROGRESS) * before:
+            self.banned.update(cells)
+
+    def _deposit(self) -> Deposit:
+        if self.deposit is None:
+            world = world_of(self.scenario)
+            self.deposit = Deposit(self.scenario, world.ground, round(CARROT_PERIOD / self.scenario.dt))
+        return self.deposit
+
+
+def _length(points: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()) if len(points) > 1 else 0.0

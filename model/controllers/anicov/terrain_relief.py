@@ -1,0 +1,82 @@
+"""Relief among walls (issue 36, item 2: the team's shares re-balanced when someone falls behind).
+
+The shares are cut so that every robot would finish together if each flew its line as planned; none does
+(a filter holds one, another's hops wind round more corners than the line counted, patches and detours add
+periods where the flight fell short). The team finishes with its slowest robot. So a robot done with its
+route takes over the end of the route of the robot with the most left to fly
+(:func:`relief`): the cut is put before the stop that makes the later of the two finish soonest, the robot
+behind keeps the stops before it, and the one relieving drives the free path to it and flies the rest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop
+from model.controllers.anicov.terrain_lanes import free_path
+from model.world.world import World
+
+RELIEF_GAIN = 4.0
+"""A relief is made only where it brings the team's end at least this many plan periods sooner."""
+
+
+@dataclass(frozen=True)
+class Relief:
+    """The robot relieved, what it keeps (its route up to the cut) and the reliever's route from where it stands."""
+
+    relieved: int
+    kept: Route
+    taken: Route
+
+
+def time_left(route: Route, k_v: float) -> float:
+    """Time units a robot needs for what is left of its route: its length at k_v and its stops' periods."""
+    stares = sum(len(stop.bearings) for stop in route.stops) * CARROT_PERIOD
+    return max(0.0, route.length - route.progress) / k_v + stares
+
+
+def relief(world: World, routes: dict[int, Route], busy: list[int], position: np.ndarray) -> Relief | None:
+    """The relief a robot standing at ``position`` gives (see the module) to the robot among ``busy`` with the
+    most left to fly; None where no cut brings the end :data:`RELIEF_GAIN` periods sooner."""
+    scenario = world.scenario
+    k_v = scenario.k_v
+    if not busy:
+        return None
+    behind = max(busy, key=lambda agent: (time_left(routes[agent], k_v), -agent))
+    route = routes[behind]
+    alone = time_left(route, k_v)
+    field = world.field(float(position[0]), float(position[1]))
+    best: tuple[float, int] | None = None
+    stares_after = np.cumsum([len(stop.bearings) for stop in route.stops][::-1])[::-1] * CARROT_PERIOD
+    for j, stop in enumerate(route.stops):
+        if j == 0 or stop.at <= route.progress:
+            continue  # the stop it is at or going to stays its own
+        x, y = route.point_at(stop.at)
+        row, col = int(y // scenario.cell), int(x // scenario.cell)
+        way = float(field[row, col]) / k_v
+        if not np.isfinite(way):
+            continue
+        kept = (stop.at - route.progress) / k_v + float(stares_after[0] - stares_after[j])
+        taken = way + (route.length - stop.at) / k_v + float(stares_after[j])
+        end = max(kept, taken)
+        if best is None or end < best[0]:
+            best = (end, j)
+    if best is None or best[0] > alone - RELIEF_GAIN * CARROT_PERIOD:
+        return None
+    return _cut(world, route, best[1], behind, position)
+
+
+def _cut(world: World, route: Route, j: int, behind: int, position: np.ndarray) -> Relief:
+    """The routes of a relief cut before stop ``j`` of ``route``."""
+    at = route.stops[j].at
+    head = np.vstack([route.points[route.along < at], route.point_at(at)[None, :]])
+    kept = Route.of(head, stops=[Stop(stop.at, stop.bearings) for stop in route.stops[:j]])
+    kept.progress = route.progress
+    way = free_path(world, position, route.point_at(at))
+    way_length = float(np.linalg.norm(np.diff(way, axis=0), axis=1).sum()) if len(way) > 1 else 0.0
+    tail = route.points[route.along > at]
+    points = np.vstack([way, tail])
+    stops = [Stop(stop.at - at + way_length, stop.bearings) for stop in route.stops[j:]]
+    return Relief(behind, kept, Route.of(points, stops=stops))

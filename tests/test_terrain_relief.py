@@ -1,0 +1,48 @@
+"""model.controllers.anicov.terrain_relief: a robot done takes over the end of the route with the most left,
+the two routes keep every stop between them, and the team's end comes sooner; no relief where none helps."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from model.controllers.anicov.route import Route, Stop
+from model.controllers.anicov.terrain_relief import RELIEF_GAIN, relief, time_left
+from model.world.world import world_of
+from tests.test_terrain_stations import ROOMS
+
+
+def long_route() -> Route:
+    """West room, bottom to top: 5 stations of 6 periods each along x = 4.5."""
+    points = np.array([[4.5, 1.5], [4.5, 14.5]])
+    return Route.of(points, stops=[Stop(at, [0.0] * 6) for at in (0.0, 3.0, 6.0, 9.0, 12.0)])
+
+
+def test_time_left_counts_the_way_at_k_v_and_the_periods():
+    route = long_route()
+    assert time_left(route, ROOMS.k_v) == pytest.approx(13.0 / ROOMS.k_v + 30 * 0.5)
+    route.progress = 13.0
+    route.stops = []
+    assert time_left(route, ROOMS.k_v) == 0.0
+
+
+def test_a_robot_done_takes_the_end_of_the_longest_route_and_every_stop_is_kept_once():
+    world = world_of(ROOMS)
+    routes = {0: long_route(), 1: Route.of(np.array([[2.5, 12.5], [3.5, 12.5]]))}
+    routes[1].progress = routes[1].length  # done
+    given = relief(world, routes, [0], np.array([3.5, 12.5]))
+    assert given is not None and given.relieved == 0
+    before = [routes[0].point_at(stop.at).tolist() for stop in routes[0].stops]
+    kept = [given.kept.point_at(stop.at).tolist() for stop in given.kept.stops]
+    taken = [given.taken.point_at(stop.at).tolist() for stop in given.taken.stops]
+    assert kept + taken == before and kept and taken
+    assert np.allclose(given.taken.points[0], [3.5, 12.5])  # from where the reliever stands
+    end = max(time_left(given.kept, ROOMS.k_v), time_left(given.taken, ROOMS.k_v))
+    assert end <= time_left(routes[0], ROOMS.k_v) - RELIEF_GAIN * 0.5
+
+
+def test_no_relief_where_the_way_there_costs_more_than_it_saves():
+    world = world_of(ROOMS)
+    short = Route.of(np.array([[4.5, 1.5], [4.5, 3.5]]), stops=[Stop(0.0, [0.0]), Stop(2.0, [0.0])])
+    assert relief(world, {0: short}, [0], np.array([22.5, 14.5])) is None
+    assert relief(world, {0: short}, [], np.array([4.5, 2.5])) is None
