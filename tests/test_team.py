@@ -77,6 +77,23 @@ def test_the_anicov_controller_over_zenoh_equals_the_engine_with_the_same_messag
     assert_same_run(tmp_path / "engine", tmp_path / "team")
 
 
+def test_anicov_among_walls_with_bodies_over_zenoh_equals_the_engine_byte_for_byte(tmp_path):
+    """Issue 36: anicov on a map with robot bodies and the safety filter (two rooms joined by a door, N = 4):
+    the coordinator's patches, detours, reliefs and cleanups are the engine's, carrot for carrot."""
+    config = write_scenario(
+        tmp_path / "s.toml", domain=[24.0, 16.0], cell=1.0, range=5.0, robot_radius=0.4, occlusion=True,
+        agents=4, seed=2, controller="anicov",
+        obstacles=[[[12.0, 0.0], [13.0, 0.0], [13.0, 6.0], [12.0, 6.0]],
+                   [[12.0, 10.0], [13.0, 10.0], [13.0, 16.0], [12.0, 16.0]]],
+    )  # fmt: skip
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+    assert engine.returncode == 0, engine.stderr
+    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record"))
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "coverage        complete" in launched.stdout
+    assert_same_run(tmp_path / "engine", tmp_path / "team")
+
+
 @pytest.mark.slow  # 35 - 38 s of wall clock (31 processes start on 2 cores): the scale check, outside the default suite
 def test_thirty_agent_processes_equal_the_engine(tmp_path):
     config = write_scenario(tmp_path / "s.toml", domain=[50.0, 50.0], agents=30, seed=1)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from model.controllers.anicov.route import Route, Stop
-from model.controllers.anicov.terrain_relief import RELIEF_GAIN, relief, time_left
+from model.controllers.anicov.terrain_relief import RELIEF_GAIN, aside, in_the_way, relief, time_left
 from model.world.world import world_of
 from tests.test_terrain_stations import ROOMS
 
@@ -46,3 +46,16 @@ def test_no_relief_where_the_way_there_costs_more_than_it_saves():
     short = Route.of(np.array([[4.5, 1.5], [4.5, 3.5]]), stops=[Stop(0.0, [0.0]), Stop(2.0, [0.0])])
     assert relief(world, {0: short}, [0], np.array([22.5, 14.5])) is None
     assert relief(world, {0: short}, [], np.array([4.5, 2.5])) is None
+
+
+def test_a_robot_with_nothing_to_do_in_a_teammate_s_way_is_sent_aside_out_of_it():
+    world = world_of(ROOMS)
+    busy = Route.of(np.array([[3.5, 8.5], [8.5, 8.5]]), stops=[Stop(5.0, [0.0])])  # to a station at (8.5, 8.5)
+    gap = 2.0 * (2.0 * ROOMS.robot_radius + ROOMS.safety_margin) + ROOMS.lookahead
+    standing = np.array([8.5, 9.0])  # beside the station
+    assert in_the_way(busy, standing, gap, 0.5)
+    assert not in_the_way(busy, np.array([3.5, 14.5]), gap, 0.5)
+    place = aside(world, standing, [busy], gap)
+    assert place is not None and not in_the_way(busy, place, gap, 0.5)
+    assert world.reachable[int(place[1] // ROOMS.cell), int(place[0] // ROOMS.cell)]
+    assert np.hypot(*(place - standing)) < 1.5 * gap + ROOMS.cell  # near: the nearest clear cell by the free path

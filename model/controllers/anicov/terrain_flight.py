@@ -31,7 +31,7 @@ from model.controllers.anicov.terrain_cleanup import (
     station_patch,
 )
 from model.controllers.anicov.terrain_lanes import free_path, piece_route
-from model.controllers.anicov.terrain_relief import relief
+from model.controllers.anicov.terrain_relief import aside, in_the_way, relief
 from model.controllers.anicov.terrain_stations import ANGLES
 from model.scenario import Scenario
 from model.world.world import world_of
@@ -72,11 +72,29 @@ class TerrainFlight:
                 if not patch_done and route.progress > self.detour_ends.get(agent, -1.0):  # nor a detour's stop
                     self.patch(routes, agent, lack)
         self.clean_up(routes, lack, positions, ids, free)
+        self.make_way(routes, positions, ids)
         for agent in ids:
             route = routes[agent]
             self.stops_left[agent] = len(route.stops)
             if route.stops and route.stops[0].bearings:
                 self.facing[agent] = route.stops[0].bearings[0]
+
+    def make_way(self, routes: dict[int, Route], positions: np.ndarray, ids: list[int]) -> None:
+        """A robot with nothing to do that stands in a busy teammate's way to its next stop steps aside
+        (:func:`terrain_relief.aside`); it stays idle."""
+        scenario = self.scenario
+        gap = 2.0 * (2.0 * scenario.robot_radius + scenario.safety_margin) + scenario.lookahead
+        busy = [routes[agent] for agent in ids if agent not in self.idle and not routes[agent].done()]
+        for index, agent in enumerate(ids):
+            if agent not in self.idle or not routes[agent].done() or not busy:
+                continue
+            ways = [way for way in busy if in_the_way(way, positions[index], gap, 0.5 * scenario.cell)]
+            if not ways:
+                continue
+            world = world_of(scenario)
+            place = aside(world, positions[index], busy, gap)
+            if place is not None:
+                routes[agent] = Route.of(free_path(world, positions[index], place), cleanup=True)
 
     def patch(self, routes: dict[int, Route], agent: int, lack: np.ndarray) -> None:
         """The robot has just faced its station's last bearing: a stop where it stands with the bearings that
