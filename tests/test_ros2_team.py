@@ -71,12 +71,14 @@ def test_three_agents_drive_three_ros2_bases_to_complete_coverage(tmp_path):
         events = read_base_log(out / "logs" / f"base-{agent}.jsonl")
         commands = [event for event in events if event["event"] == "command"]
         counts = json.loads((out / "logs" / f"agent-{agent}.counts.json").read_text())
-        # Every step the agent took sent a Twist, and every Twist sent reached the base. Not the team's step
-        # count: on a loaded machine an agent's 40 Hz tick may come too late for a step (a fresh clone's CI
-        # run under pytest-xdist, 2026-12-06: 712 Twists for the team's 734 steps), which is the clock's
-        # business, not the bridge's.
+        # Every step the agent took sent a Twist, and the Twists sent reached the base but for the few that the
+        # command publisher drops under congestion (Zenoh's default for it, DROP: a late command is
+        # worth less than the next one; the stops go reliably). Not the team's step count: on a loaded
+        # machine an agent's 40 Hz tick may come too late for a step (a fresh clone's CI run under
+        # pytest-xdist, 2026-12-06: 712 Twists for the team's 734 steps), which is the clock's business. Dropped,
+        # measured: none on a quiet machine, 2 of 756 with a study sharing the two cores.
         assert counts["robot"]["commands_sent"] >= counts["steps"] > 0
-        assert len(commands) == counts["robot"]["commands_sent"]
+        assert 0.98 * counts["robot"]["commands_sent"] <= len(commands) <= counts["robot"]["commands_sent"]
         assert (commands[-1]["v"], commands[-1]["omega"]) == (0.0, 0.0)  # left standing still
         assert counts["rejected"] == 0 and counts["robot"]["poses_rejected"] == 0
 
