@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import signal
+import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -28,6 +30,20 @@ def assert_same_run(engine_dir, team_dir):
         assert (engine_dir / name).read_bytes() == (team_dir / name).read_bytes(), name
 
 
+def engine_then_team(
+    tmp_path: Path, config: Path, *flags: str, team: str | None = None, timeout: float = 300
+) -> subprocess.CompletedProcess[str]:
+    """``anicov run`` of ``config`` into tmp_path/engine, then the launcher's team into tmp_path/team (``flags``
+    added), both asserted to exit 0; the launcher's result."""
+    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
+    assert engine.returncode == 0, engine.stderr
+    launched = run(
+        launcher_command("--config", str(config), "--out", str(tmp_path / "team"), *flags, team=team), timeout
+    )
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    return launched
+
+
 @pytest.mark.parametrize(
     ("agents", "domain", "bus", "deltas"),
     [
@@ -42,12 +58,8 @@ def test_lockstep_over_zenoh_equals_in_process_engine_byte_for_byte(tmp_path, ag
     (the default) or clients of the launcher's router; the two options are independent, so one run tries
     both other choices (the secure and the ROS 2 teams also run through a router)."""
     config = write_scenario(tmp_path / "s.toml", domain=domain, agents=agents, seed=3)
-    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
-    assert engine.returncode == 0, engine.stderr
     team = unique_team()
-    flags = ("--bus", bus, "--deltas", deltas)
-    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), *flags, team=team))
-    assert launched.returncode == 0, launched.stderr + launched.stdout
+    launched = engine_then_team(tmp_path, config, "--bus", bus, "--deltas", deltas, team=team)
     assert "coverage        complete" in launched.stdout
     assert_same_run(tmp_path / "engine", tmp_path / "team")
     counts = json.loads((tmp_path / "team" / "coordinator_counts.json").read_text())
@@ -67,11 +79,7 @@ def test_the_anicov_controller_over_zenoh_equals_the_engine_with_the_same_messag
     config = write_scenario(
         tmp_path / "s.toml", domain=[40.0, 40.0], agents=3, seed=5, controller="best", stations=stations
     )
-    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
-    assert engine.returncode == 0, engine.stderr
-    team = unique_team()
-    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record", team=team))
-    assert launched.returncode == 0, launched.stderr + launched.stdout
+    launched = engine_then_team(tmp_path, config, "--no-record", team=unique_team())
     assert "coverage        complete" in launched.stdout
     assert json.loads((tmp_path / "team" / "summary.json").read_text())["scenario"]["controller"] == "anicov"
     assert_same_run(tmp_path / "engine", tmp_path / "team")
@@ -86,10 +94,7 @@ def test_anicov_among_walls_with_bodies_over_zenoh_equals_the_engine_byte_for_by
         obstacles=[[[12.0, 0.0], [13.0, 0.0], [13.0, 6.0], [12.0, 6.0]],
                    [[12.0, 10.0], [13.0, 10.0], [13.0, 16.0], [12.0, 16.0]]],
     )  # fmt: skip
-    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
-    assert engine.returncode == 0, engine.stderr
-    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record"))
-    assert launched.returncode == 0, launched.stderr + launched.stdout
+    launched = engine_then_team(tmp_path, config, "--no-record")
     assert "coverage        complete" in launched.stdout
     assert_same_run(tmp_path / "engine", tmp_path / "team")
 
@@ -97,11 +102,8 @@ def test_anicov_among_walls_with_bodies_over_zenoh_equals_the_engine_byte_for_by
 @pytest.mark.slow  # 35 - 38 s of wall clock (31 processes start on 2 cores): the scale check, outside the default suite
 def test_thirty_agent_processes_equal_the_engine(tmp_path):
     config = write_scenario(tmp_path / "s.toml", domain=[50.0, 50.0], agents=30, seed=1)
-    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
-    assert engine.returncode == 0, engine.stderr
     team = unique_team()
-    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), team=team), timeout=480)
-    assert launched.returncode == 0, launched.stderr + launched.stdout
+    launched = engine_then_team(tmp_path, config, team=team, timeout=480)
     assert "coordinator + 30 agents" in launched.stdout
     assert_same_run(tmp_path / "engine", tmp_path / "team")
     assert processes_of(team) == []
@@ -175,11 +177,8 @@ def test_a_team_on_a_map_equals_the_engine_and_its_recording_shows_the_map(tmp_p
     write_map(tmp_path, "site", occupied)
     # Issue 11's terrain alone; the filter on a map over Zenoh is tests/test_safety_cases.py's corridor.
     config = write_scenario(tmp_path / "s.toml", map="site.yaml", agents=3, seed=2, robot_radius=0.4, safety=False)
-    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
-    assert engine.returncode == 0, engine.stderr
     team = unique_team()
-    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), team=team))
-    assert launched.returncode == 0, launched.stderr + launched.stdout
+    launched = engine_then_team(tmp_path, config, team=team)
     assert "coverage        complete" in launched.stdout and "terrain" in launched.stdout
     assert_same_run(tmp_path / "engine", tmp_path / "team")
     summary = json.loads((tmp_path / "team" / "summary.json").read_text())
@@ -195,10 +194,7 @@ def test_a_plug_in_controller_over_zenoh_equals_the_engine_byte_for_byte(tmp_pat
     config = write_scenario(
         tmp_path / "s.toml", domain=[40.0, 40.0], agents=2, seed=3, controller=f"{example}:NearestUncovered"
     )
-    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
-    assert engine.returncode == 0, engine.stderr
-    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record"))
-    assert launched.returncode == 0, launched.stderr + launched.stdout
+    launched = engine_then_team(tmp_path, config, "--no-record")
     assert "coverage        complete" in launched.stdout
     assert_same_run(tmp_path / "engine", tmp_path / "team")
 
@@ -242,10 +238,7 @@ def test_a_team_on_a_map_saved_with_an_unknown_border_equals_the_engine_in_the_m
 
     scenario_on_saved_map(tmp_path)
     config = tmp_path / "s.toml"
-    engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
-    assert engine.returncode == 0, engine.stderr
-    launched = run(launcher_command("--config", str(config), "--out", str(tmp_path / "team"), "--no-record"))
-    assert launched.returncode == 0, launched.stderr + launched.stdout
+    launched = engine_then_team(tmp_path, config, "--no-record")
     assert "unknown border cropped" in launched.stderr
     assert_same_run(tmp_path / "engine", tmp_path / "team")
     corner = json.loads((tmp_path / "team" / "summary.json").read_text())["terrain"]["map_corner"]

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model.controllers.anicov.route import Route, Stop, arrive_radius_of
+from model.controllers.anicov.route import Route, Stop, face_radius_of
 from model.controllers.anicov.terrain_cleanup import (
     CLEANUP_DEMAND,
     SURE_SPREADS,
@@ -53,7 +53,7 @@ def test_the_cleanup_s_stations_surely_bring_every_short_cell_to_its_need():
     stations, periods = cleanup_stations(world, deposit, need)
     assert len(stations) >= 1 and periods.sum() >= 1 and (periods == np.round(periods)).all()
     assert len({tuple(point) for point in stations}) == len(stations)  # one station per point
-    sure = deposit.sure_stares(stations, ANGLES, SURE_SPREADS * arrive_radius_of(ROOMS))
+    sure = deposit.sure_stares(stations, ANGLES, SURE_SPREADS * face_radius_of(ROOMS))
     brought = sure @ periods.ravel()
     for row, col in cells:
         assert brought[row * ROOMS.grid_shape[1] + col] >= CLEANUP_DEMAND * 0.6 - 1e-9
@@ -75,7 +75,7 @@ def test_nothing_short_needs_no_station_and_a_banned_cell_is_never_one():
 def test_a_cell_seen_past_a_wall_s_corner_gets_a_station_that_sees_it_from_all_round():
     world, deposit = world_of(ROOMS), deposit_of(ROOMS)
     cells = world.coverable.ravel().nonzero()[0]
-    spread = SURE_SPREADS * arrive_radius_of(ROOMS)
+    spread = SURE_SPREADS * face_radius_of(ROOMS)
     found = 0
     for flat in cells[::7]:
         got = _sure_seer(world, deposit, int(flat), frozenset())

@@ -24,6 +24,7 @@ import numpy as np
 from model.controllers.anicov.deposit import Deposit
 from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop, arrive_radius_of
 from model.controllers.anicov.terrain_cleanup import (
+    cell_of,
     cleanup_pieces,
     cleanup_stations,
     left_near,
@@ -88,8 +89,7 @@ class TerrainFlight:
         for index, agent in enumerate(ids):
             if agent not in self.idle or not routes[agent].done() or not busy:
                 continue
-            ways = [way for way in busy if in_the_way(way, positions[index], gap, 0.5 * scenario.cell)]
-            if not ways:
+            if not any(in_the_way(way, positions[index], gap, 0.5 * scenario.cell) for way in busy):
                 continue
             world = world_of(scenario)
             place = aside(world, positions[index], busy, gap)
@@ -104,14 +104,12 @@ class TerrainFlight:
         ahead = route.point_at(route.progress + 2.0 * self.scenario.range)
         leave = math.atan2(ahead[1] - station[1], ahead[0] - station[0]) if route.progress < route.length else None
         others = [other for key, other in routes.items() if key != agent] + [route]
-        bearings = station_patch(
-            world_of(self.scenario), self._deposit(), lack, station, others, (self.facing.get(agent), leave)
-        )
+        world, deposit = world_of(self.scenario), self._deposit()
+        bearings = station_patch(world, deposit, lack, station, others, (self.facing.get(agent), leave))
         if bearings:
             route.stops.insert(0, Stop(route.progress, bearings))
             self.patched[agent] = route.progress
-        world, deposit = world_of(self.scenario), self._deposit()
-        behind = left_near(world, deposit, lack, station, [*others])
+        behind = left_near(world, deposit, lack, station, others)
         if not (behind > 0.0).any():
             return
         stations, periods = cleanup_stations(world, deposit, behind, frozenset(self.banned))
@@ -128,14 +126,16 @@ class TerrainFlight:
         here = route.point_at(route.progress)
         out, stops = piece_route(world, scenario, here, stations, periods)
         back = free_path(world, out[-1], here)
-        there = _length(out) + _length(back)
+        there = Route.of(out).length + Route.of(back).length
         if there > DETOUR_MOST * scenario.range:
             return None
         rest = np.vstack([here[None, :], route.points[route.along > route.progress]])
-        kept = [Stop(stop.at - route.progress + there, stop.bearings) for stop in route.stops]
-        here_first = [stop for stop in kept if stop.at <= there + 1e-9]  # the patch where it stands: before it goes
-        later = [stop for stop in kept if stop.at > there + 1e-9]
-        here_first = [Stop(0.0, stop.bearings) for stop in here_first]
+        here_first = [Stop(0.0, stop.bearings) for stop in route.stops if stop.at <= route.progress + 1e-9]  # its patch
+        later = [
+            Stop(stop.at - route.progress + there, stop.bearings)
+            for stop in route.stops
+            if stop.at > route.progress + 1e-9
+        ]
         return Route.of(np.vstack([out, back[1:], rest[1:]]), stops=[*here_first, *stops, *later]), there
 
     def clean_up(
@@ -173,7 +173,7 @@ class TerrainFlight:
             routes[agent] = Route.of(path, cleanup=True, stops=stops)
             self.idle.discard(agent)
             reached = np.unique(np.concatenate([deposit.stare_cells(*xy, a)[0] for xy in own for a in ANGLES]))
-            cells = [(int(y // self.scenario.cell), int(x // self.scenario.cell)) for x, y in own]
+            cells = [cell_of(point, self.scenario.cell) for point in own]
             self.cleaning[agent] = (cells, reached, float(lack.ravel()[reached].sum()))
 
     def _relieve(self, routes: dict[int, Route], ids: list[int], agent: int, position: np.ndarray) -> None:
@@ -211,7 +211,3 @@ class TerrainFlight:
             world = world_of(self.scenario)
             self.deposit = Deposit(self.scenario, world.ground, round(CARROT_PERIOD / self.scenario.dt))
         return self.deposit
-
-
-def _length(points: np.ndarray) -> float:
-    return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()) if len(points) > 1 else 0.0

@@ -80,7 +80,7 @@ def _cut(world: World, route: Route, j: int, behind: int, position: np.ndarray) 
     kept = Route.of(head, stops=[Stop(stop.at, stop.bearings) for stop in route.stops[:j]])
     kept.progress = route.progress
     way = free_path(world, position, route.point_at(at))
-    way_length = float(np.linalg.norm(np.diff(way, axis=0), axis=1).sum()) if len(way) > 1 else 0.0
+    way_length = Route.of(way).length
     tail = route.points[route.along > at]
     points = np.vstack([way, tail])
     stops = [Stop(stop.at - at + way_length, stop.bearings) for stop in route.stops[j:]]
