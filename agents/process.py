@@ -44,6 +44,7 @@ from protocol.agreement import (
 from protocol.messages import AgentState, AgentStep, MapDelta, encode
 from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
 from protocol.session import RouterUnreachable, logger_listens, open_session, team_publisher, zenoh_config
+from protocol.settling import EndBarrier, settle
 from protocol.sync import SYNC_PERIOD, SyncServer, sync_with
 from protocol.traffic import TrafficReporter
 from runtime.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
@@ -132,7 +133,7 @@ def run_on_bus(session: zenoh.Session, node: AgentNode, stop: StopFlag, parent: 
         raise
     finally:
         node.robot.stop()  # before the end-of-run exchanges: a real base must not roll on meanwhile
-    finish_run(bus, lockstep)
+    finish_run(bus, lockstep, stop)
     traffic.stop()
     node.bytes_served = bus.traffic()[0] - node.bytes_sent
     bus.token.undeclare()
@@ -150,6 +151,7 @@ class Bus:
     history: History
     loss: LossTimer  # lockstep: how long a silence means a lost go
     sync: SyncServer | None = None  # comm_range: anti-entropy answers
+    barrier: EndBarrier | None = None  # realtime: nobody leaves before every replica is whole
 
     def traffic(self) -> tuple[int, int]:
         """Payload bytes out (published, and replies to teammates' queries) and in, so far."""
@@ -195,7 +197,8 @@ def declare_endpoints(session: zenoh.Session, node: AgentNode, lockstep: bool) -
         keys.agent_snapshot(agent),
         lambda query: query.reply(keys.agent_snapshot(agent), encode(node.replica.snapshot())),
     )
-    return Bus(session, node, step_publisher, token, history, LossTimer(), sync)
+    barrier = None if lockstep else EndBarrier(session, keys, "agent", agent)
+    return Bus(session, node, step_publisher, token, history, LossTimer(), sync, barrier)
 
 
 SNAPSHOT_TRIES = 10
@@ -368,21 +371,21 @@ def exchange_with_contacts(bus: Bus, last_sync: dict[int, float]) -> None:
             sync_with(bus.session, node.keys.agent_sync(teammate), node.replica, node.inbox, node.scenario.agents)
 
 
-def finish_run(bus: Bus, lockstep: bool) -> None:
+def finish_run(bus: Bus, lockstep: bool, stop: StopFlag) -> None:
     """Let in-flight deltas of teammates land, so every replica ends with the same map."""
     node = bus.node
-    if node.finished is not None:
+    if lockstep and node.finished is not None:
         node.inbox.drain(0.5, node.handle)
     if lockstep and node.lost_last_go():
         # The last go (every member's last delta) was lost and the end of the run came first: it is in
         # the coordinator's history.
         bus.recover_go()
         node.handle_queued()
-    if node.finished is not None and not lockstep:
-        # Realtime: the last deltas of a teammate have no later one to reveal their loss; ask every
-        # history for what follows our contiguous run, then stay a moment to answer the others' asks.
-        fill_gaps(bus.session, node.keys, node.replica, node.inbox, to_the_end=node.others())
-        node.inbox.drain(0.5, node.handle)
+    if bus.barrier is not None and node.finished is not None and not stop.stopped:
+        # Realtime: the last deltas of a teammate have no later one to reveal their loss; once every
+        # teammate has stopped, ask every history for what follows our contiguous run, and stay until
+        # every teammate's replica is whole (it may still ask ours). See protocol.settling.
+        settle(bus.barrier, node.replica, node.inbox, node.handle, node.others(), lambda: stop.stopped)
     node.apply_remaining_gos()
 
 

@@ -10,8 +10,8 @@ from pathlib import Path
 from coordinator.endpoints import CoordinatorBus
 from coordinator.stepping import Stepping
 from protocol.messages import RunControl, encode
-from protocol.recovery import fill_gaps
 from protocol.session import logger_listens
+from protocol.settling import settle
 from runtime.rundir import write_run_directory
 
 log = logging.getLogger("anicov.coordinator")
@@ -41,20 +41,18 @@ def announce_end(bus: CoordinatorBus, stepping: Stepping) -> bytes | None:
     return done
 
 
-def settle_last_deltas(bus: CoordinatorBus, done: bytes | None) -> None:
+def settle_last_deltas(bus: CoordinatorBus, done: bytes | None, stopped: Callable[[], bool]) -> None:
     """Deltas still in flight (realtime agents step until they hear the end) join the map, and those lost
-    on the way, last ones included (see fill_gaps). Lockstep: nothing is in flight, the last go closed
-    every step."""
+    on the way, last ones included: once every agent has stopped, each history is asked for what follows
+    the replica's contiguous run (see protocol.settling). Lockstep: nothing is in flight, the last go
+    closed every step."""
     node = bus.node
-    realtime = not node.lockstep
     node.open_step = None
-    if realtime:
-        node.inbox.drain(0.5, node.handle)
     if done is not None:
         bus.publish(bus.control, done)  # again, for whoever lost the first (it is idempotent)
-    if realtime:
-        fill_gaps(bus.session, bus.keys, node.replica, node.inbox, to_the_end=range(node.scenario.agents))
-        node.inbox.drain(0.5, node.handle)
+    if bus.barrier is not None and not stopped():
+        # The agents wait for our 'whole' before they leave; we wait for no one's (we serve no deltas).
+        settle(bus.barrier, node.replica, node.inbox, node.handle, range(node.scenario.agents), stopped, ())
 
 
 def write_outputs(bus: CoordinatorBus, stepping: Stepping, resumed_at: int | None, out: str | None) -> None:

@@ -16,6 +16,7 @@ from protocol.keys import TeamKeys
 from protocol.messages import Message, RunControl, StepGo, encode
 from protocol.recovery import History
 from protocol.session import team_publisher
+from protocol.settling import EndBarrier
 
 
 @dataclass
@@ -29,6 +30,7 @@ class CoordinatorBus:
     control: zenoh.Publisher
     status: zenoh.Publisher
     token: zenoh.LivelinessToken
+    barrier: EndBarrier | None  # realtime: the run's end waits for the agents to stop (protocol.settling)
 
     @classmethod
     def declare(cls, session: zenoh.Session, node: Coordinator) -> CoordinatorBus:
@@ -46,7 +48,8 @@ class CoordinatorBus:
         control = team_publisher(session, keys.control)
         status = team_publisher(session, keys.status)
         token = session.liveliness().declare_token(keys.alive("coordinator"))
-        return cls(session, keys, node, objectives, go, go_history, control, status, token)
+        barrier = None if node.lockstep else EndBarrier(session, keys, "coordinator", 0)
+        return cls(session, keys, node, objectives, go, go_history, control, status, token, barrier)
 
     def traffic(self) -> tuple[int, int]:
         """Payload bytes out (published, and the gos served again) and in, so far."""

@@ -68,7 +68,7 @@ def run_coordinator(scenario: Scenario, options: CoordinatorOptions, config: zen
                 if stepping.outcome is None or node.lockstep:
                     stepping.status_if_due()
             done = announce_end(bus, stepping)
-            settle_last_deltas(bus, done)
+            settle_last_deltas(bus, done, lambda: stop.stopped or parent_is_gone(parent))
             traffic.stop()
             bus.token.undeclare()
             write_outputs(bus, stepping, step if found.running else None, options.out)

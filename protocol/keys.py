@@ -22,6 +22,9 @@ run/control                 RunControl           coordinator → all   run done 
 run/status                  RunControl           coordinator → all   progress (e_D, step)
 traffic/<role>/<id>         Traffic              every process       bytes out and in so far, each second
 alive/<role>/<id>           liveliness token     every process       agent/<id>, coordinator/0, logger/0
+ending/<phase>/<role>/<id>  liveliness token     agent, coordinator  realtime end of run: stopped (no more
+                                                                     deltas), whole (replica has them all);
+                                                                     see protocol.settling
 """
 
 from __future__ import annotations
@@ -130,6 +133,17 @@ class TeamKeys:
     @property
     def alive_agents(self) -> str:
         return f"{self.prefix}/alive/agent/*"
+
+    @property
+    def alive_everyone(self) -> str:
+        return f"{self.prefix}/alive/*/*"
+
+    def ending(self, phase: str, role: str, ident: int = 0) -> str:
+        return f"{self.prefix}/ending/{phase}/{role}/{ident}"
+
+    @property
+    def all_endings(self) -> str:
+        return f"{self.prefix}/ending/*/*/*"
 
     @property
     def everything(self) -> str:
