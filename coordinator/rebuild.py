@@ -3,8 +3,10 @@
 Step by step from 0, the deltas of step s−1 enter the replica (Λ_s), e_D and the map snapshots are
 logged, the states of step s are recorded and, in lockstep on a replanning step, the planner runs on
 Λ_s and the poses of step s, so its memory of blobs is the one the lost coordinator had. In realtime
-the plans ran on the wall clock and are not replayed, except the anicov controller's first, which cut
-its routes from the starting poses: each robot is then put back on its route (LanePlanner.resume). The run
+the plans ran on the wall clock and the paper's law keeps nothing of them worth restoring; a planner
+whose plans build on each other (``TeamPlanner.replayed``: anicov's routes, cut once from the starting
+poses, their progress, patches, detours and cleanups) is replayed as in lockstep, on every plan step, so
+each robot goes on with the route, stops and cleanup it had, never flying covered ground again. The run
 resumes at the latest step every member has published. In lockstep that step is still open (its
 deltas go into the next go), so a run that lost its coordinator still equals the engine. Agents gone
 before the restart left no history: their coverage is adopted from a member's snapshot.
@@ -58,13 +60,8 @@ def rebuild(node: Coordinator, messages: HistoryMessages, members: set[int], sna
             node.log.events.append(f"coverage of agents {sorted(gone)} taken from a member's snapshot")
         if node.lockstep:
             node.open_step = resume
-        elif node.planner.cut_at_start:
-            # Realtime plans are not replayed (they ran on the wall clock), but routes cut once, at the first
-            # plan (anicov's), are: put each robot back on its own.
-            positions = [node.positions[agent] for agent in sorted(publishing)]
-            resumed = node.planner.resume(node.replica.map.lack_of_coverage(), positions, sorted(publishing))
-            if resumed:
-                node.log.events.append(resumed)
+        elif node.planner.replayed:
+            node.log.events.append(f"plans replayed from the histories to step {resume}")
         # What lies beyond: the open step's deltas (for the next go) and any later ones.
         for message in messages:
             if isinstance(message, MapDelta) and message.seq >= resume and message.agent in members:
@@ -88,10 +85,8 @@ def replay(
         for state in states.get(step, []):
             node.log.record(state)
             node.positions[state.agent] = (state.pose[0], state.pose[1])
-        if node.lockstep and step % node.scenario.plan_steps == 0:
+        if (node.lockstep or node.planner.replayed) and step % node.scenario.plan_steps == 0:
             node.plan(step)
-        elif step == 0 and node.planner.cut_at_start:
-            node.plan(step)  # realtime: the routes as the first plan cut them, from the starting poses
         for state in states.get(step, []):
             node.latest_state_step[state.agent] = step
             node.positions[state.agent] = (state.next_pose[0], state.next_pose[1])

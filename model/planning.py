@@ -30,9 +30,10 @@ class TeamPlanner:
     blobs: BlobObjectives | None = None
     """Algorithm 1's blobs of the last plan, when the planner runs it: what the recording keeps of a plan."""
 
-    cut_at_start = False
-    """True when the first plan fixes each robot's whole route from the starting poses: a coordinator
-    rebuilt in realtime plans step 0 again from those poses, then :meth:`resume`s."""
+    replayed = False
+    """True when each plan builds on the ones before (anicov's routes, cut once from the starting poses, and
+    their progress, patches and cleanups): a coordinator restarted in realtime then replays every plan step
+    from the agents' histories, as a lockstep one always does (:mod:`coordinator.rebuild`)."""
 
     def plan(self, lack: np.ndarray, positions: np.ndarray, members: list[int] | None = None) -> np.ndarray:
         raise NotImplementedError
@@ -47,10 +48,6 @@ class TeamPlanner:
         """This plan as kept for the recording: members are all agents, in id order."""
         centres = np.zeros((0, 2)) if self.blobs is None else self.blobs.positions.copy()
         return (step, tuple(range(len(targets))), targets.copy(), centres, self.labels())
-
-    def resume(self, lack: np.ndarray, positions: list[tuple[float, float]], members: list[int]) -> str | None:
-        """Put each member back on its plan after a restart (realtime); what was done, for the run log."""
-        return None
 
 
 def path_lengths(world: World, positions: np.ndarray, objectives: np.ndarray) -> np.ndarray:

@@ -475,9 +475,9 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     An agent killed before the coordinator left no history: its coverage comes from a member's replica."""
     team, port = unique_team(), free_port()
     out = tmp_path / "run"
-    # Realtime runs the anicov controller, on a smaller square: its routes, cut once at the first plan,
-    # must be cut again and each robot put back on its own (the paper's law keeps nothing a realtime
-    # rebuild must restore).
+    # Realtime runs the anicov controller, on a smaller square: its plans build on each other (routes cut
+    # once at the first plan, their progress), so they are replayed from the histories (the paper's law
+    # keeps nothing a realtime rebuild must restore).
     if clock == "realtime":
         anicov_square = write_scenario(tmp_path / "s.toml", domain=[60.0, 60.0], agents=4, seed=0, controller="anicov")
         extra = ["--config", str(anicov_square), "--speed", "40"]
@@ -510,7 +510,9 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is True
     if clock == "realtime":
-        assert any(event.startswith("anicov routes cut again") for event in counts["events"]), counts["events"]
+        assert any(event.startswith("plans replayed from the histories") for event in counts["events"]), counts[
+            "events"
+        ]
     assert 0 < counts["resumed_at"] < summary["steps"]  # it really died mid-run
     assert_every_replica_holds_every_published_delta_once(out, agents=4)
     if clock == "lockstep":

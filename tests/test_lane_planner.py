@@ -97,37 +97,3 @@ def test_best_names_the_anicov_controller_which_flies_stations_among_walls_and_p
         PAPER.with_overrides(controller="anicov", robot_radius=0.5, stations=False)
     with pytest.raises(ScenarioError, match="'planning'"):
         PAPER.with_overrides(controller="anicov", planning="local")
-
-
-def test_a_rebuilt_planner_puts_each_robot_back_on_its_route_or_frees_it():
-    """LanePlanner.resume (a coordinator restarted in realtime): the routes cut again from the starting
-    positions are the lost planner's; a robot on its piece resumes where it stands, one far from it (on a
-    pass) or with nothing uncovered left along it is done, so it gets a pass rather than covered ground."""
-    scenario = PAPER.with_overrides(agents=3)
-    start = np.array([[10.0, 10.0], [90.0, 20.0], [50.0, 80.0]])
-    lack = np.ones(scenario.grid_shape)
-    lost = LanePlanner(scenario)
-    lost.plan(lack, start)
-    now = np.array([lost.routes[agent].point_at(0.4 * lost.routes[agent].length) for agent in range(3)])
-    now[0] += [0.3, -0.2]  # a robot is never exactly on its path
-    now[1] = lost.routes[0].point_at(0.9 * lost.routes[0].length)  # over on agent 0's piece: a pass
-    assert lost.routes[1].nearest(now[1])[0] > lost.spacing / 2.0
-    behind_2 = lost.routes[2].point_at(0.4 * lost.routes[2].length)
-    rebuilt = LanePlanner(scenario)
-    rebuilt.plan(lack, start)
-    for agent in range(3):
-        assert np.array_equal(rebuilt.routes[agent].points, lost.routes[agent].points)
-    # Everything along agent 2's route from where it stands is covered: it had flown it.
-    strip = np.zeros(scenario.grid_shape, dtype=bool)
-    half = math.ceil(lost.spacing / 2.0) + 1  # cells
-    for distance in np.arange(0.4 * lost.routes[2].length, lost.routes[2].length, 0.5):
-        x, y = lost.routes[2].point_at(distance)
-        strip[max(int(y) - half, 0) : int(y) + half + 1, max(int(x) - half, 0) : int(x) + half + 1] = True
-    lack[strip] = 0.0
-    rebuilt.resume(lack, np.vstack([now[:2], behind_2]), [0, 1, 2])
-    assert math.isclose(rebuilt.routes[0].progress, 0.4 * lost.routes[0].length, abs_tol=0.5)
-    assert not rebuilt.routes[0].done()
-    assert rebuilt.routes[1].done() and rebuilt.routes[2].done()
-    targets = rebuilt.plan(lack, np.vstack([now[:2], behind_2]))
-    assert np.allclose(targets[0], rebuilt.routes[0].point_at(rebuilt.routes[0].progress + LOOKAHEAD))
-    assert rebuilt.routes[1].cleanup and rebuilt.routes[2].cleanup  # freed robots are given passes

@@ -68,17 +68,27 @@ def test_members_without_a_history_are_left_out_and_no_history_at_all_is_an_erro
         resume_step({}, {0, 1})
 
 
-def test_a_realtime_anicov_coordinator_cuts_its_routes_again_and_puts_each_robot_back():
-    """Realtime plans are not replayed, but the anicov controller's routes were cut at the first plan,
-    from the starting poses: the rebuilt planner holds the same routes, each robot located on its own."""
-    scenario = SCENARIO.with_overrides(controller="anicov")
-    steps = team_steps(scenario, 6)
-    node = Coordinator(scenario, CoordinatorOptions("t", clock="realtime"))
-    rebuild(node, history(steps, {0: 5, 1: 5}), members={0, 1})
+def test_a_realtime_anicov_coordinator_replays_its_plans_as_a_lockstep_one_does():
+    """Issue 36, item 3: anicov's plans build on each other (routes cut once, their progress, patches and
+    cleanups, among walls too), so a coordinator restarted in realtime replays every plan step from the
+    histories: its planner ends where a lockstep rebuild's (which equals the engine's) does, robots part way
+    along their routes, not put back at the routes' starts nor cut afresh."""
+    wall = [[14.0, 0.0], [16.0, 0.0], [16.0, 18.0], [14.0, 18.0]]
+    scenario = SCENARIO.with_overrides(controller="anicov", robot_radius=0.3, occlusion=True, obstacles=[wall])
+    steps = team_steps(scenario, 41)
+    planners = {}
+    for clock in ("lockstep", "realtime"):
+        node = Coordinator(scenario, CoordinatorOptions("t", clock=clock))
+        rebuild(node, history(steps, {0: 40, 1: 40}), members={0, 1})
+        planners[clock] = node.planner
+    assert "plans replayed from the histories to step 40" in node.log.events
+    lockstep, realtime = planners["lockstep"], planners["realtime"]
+    assert isinstance(realtime, LanePlanner) and realtime.flight is not None  # the flight among walls
+    for agent in (0, 1):
+        ours, theirs = realtime.routes[agent], lockstep.routes[agent]
+        assert np.array_equal(ours.points, theirs.points) and ours.progress == theirs.progress
+        assert ours.stops == theirs.stops
+    assert realtime.flight.stops_left == lockstep.flight.stops_left and realtime.flight.idle == lockstep.flight.idle
     fresh = LanePlanner(scenario)
     fresh.plan(np.ones(scenario.grid_shape), initial_poses(scenario)[:, :2])
-    for agent in (0, 1):
-        route = node.planner.routes[agent]
-        assert np.array_equal(route.points, fresh.routes[agent].points)
-        gap, at = route.nearest(np.array(node.positions[agent]))
-        assert route.done() or (gap <= node.planner.spacing / 2.0 and route.progress == at)
+    assert any(realtime.routes[agent].progress > fresh.routes[agent].progress for agent in (0, 1))

@@ -48,7 +48,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import cv2
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
@@ -109,7 +108,7 @@ def blob_passes(
 class LanePlanner(TeamPlanner):
     """The ``anicov`` controller's planning (see the module): one carrot per robot per call."""
 
-    cut_at_start = True  # the first plan cuts every robot's route from the starting poses
+    replayed = True  # the first plan cuts every robot's route; later ones advance, patch and clean up
 
     scenario: Scenario
     blobs: BlobObjectives = field(default_factory=BlobObjectives)
@@ -189,38 +188,6 @@ class LanePlanner(TeamPlanner):
             or (waiting[0].start <= route.progress + LOOKAHEAD and not (lack[waiting[0].spot] > 0.0).any())
         ):
             route.progress = max(route.progress, waiting.pop(0).end)
-
-    def resume(self, lack: np.ndarray, positions: np.ndarray, members: list[int]) -> str | None:
-        """A planner rebuilt after its coordinator was lost in realtime, its routes cut again at a first
-        plan on the robots' starting positions (as the lost one cut them): each robot is put at the nearest
-        point of its route, and its route is done if it stands farther than half a spacing from it (it was
-        on a pass) or nothing uncovered lies within half a spacing of what is left of it (it had flown
-        it), so that the next plan gives it a pass instead of flying covered ground again."""
-        positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
-        for index, agent in enumerate(members):
-            route = self.routes.get(agent)
-            if route is None or route.cleanup:
-                continue
-            gap, at = route.nearest(positions[index])
-            route.progress = at
-            # Stations stood at before the loss are done; the one it stands at (or was reaching) is done again.
-            route.stops = [stop for stop in route.stops if stop.at > at - FACE_RADIUS]
-            if gap > self.spacing / 2.0 or not self._left_to_cover(lack, route):
-                route.progress, route.stops = route.length, []
-        if not self.routes:
-            return None
-        on_routes = [agent for agent in members if not self.routes[agent].done()]
-        return f"anicov routes cut again; agents {on_routes} resume on theirs, the others take passes"
-
-    def _left_to_cover(self, lack: np.ndarray, route: Route) -> bool:
-        """Whether an uncovered cell lies within half a spacing of the route from its progress on, or within
-        R of a station it has yet to stand at (its camera turns there)."""
-        strip = np.zeros(lack.shape, dtype=np.uint8)
-        route.draw_ahead(strip, self.scenario.cell, self._strip_cells())
-        for stop in route.stops:
-            centre = np.round(route.point_at(stop.at) / self.scenario.cell).astype(np.int32)
-            cv2.circle(strip, (int(centre[0]), int(centre[1])), round(self.scenario.range / self.scenario.cell), 1, -1)
-        return bool((lack[strip.astype(bool)] > 0.0).any())
 
     def _strip_cells(self) -> int:
         """The width, in cells, of the strip a route sweeps: a lane spacing, half of it each side."""
