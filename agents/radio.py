@@ -62,8 +62,9 @@ class RadioLink:
         return [agent for agent in range(self.scenario.agents) if agent != self.me and self.heard_live[agent] >= recent]
 
     def plan_due(self, step: int) -> bool:
-        """Realtime, local planning: a plan every replan_period (and at the first step)."""
-        return self.planner is not None and step - self.planned_at >= self.scenario.replan_steps
+        """Realtime, local planning: a plan every plan period of the controller (the paper's law: replan_period;
+        anicov: a carrot every CARROT_PERIOD), and at the first step."""
+        return self.planner is not None and step - self.planned_at >= self.scenario.plan_steps
 
     def local_objective(
         self, members: list[int], pose: Pose, positions: np.ndarray, lack: np.ndarray, step: int

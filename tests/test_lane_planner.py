@@ -14,6 +14,7 @@ from anicov.engine import run_scenario
 from model.controllers.anicov.lane_planner import LOOKAHEAD, LanePlanner, blob_passes
 from model.paper.control import pursuit_law
 from model.paper.geometry import wrap_angle
+from model.parameters import initial_poses
 from model.scenario import Scenario, ScenarioError, load_scenario
 
 PAPER = Scenario(stations=False)  # the spiral (tests/test_stations.py has the stations)
@@ -89,11 +90,29 @@ def test_the_pursuit_law_without_a_weave_is_pure_pursuit(x, y, theta, goal_x, go
     assert omega == e_theta
 
 
-def test_best_names_the_anicov_controller_which_flies_stations_among_walls_and_plans_centrally():
+def test_best_names_the_anicov_controller_which_flies_stations_among_walls_and_plans_anywhere():
     assert PAPER.with_overrides(controller="best").controller == "anicov"
     assert PAPER.with_overrides(controller="anicov").plan_steps == 5  # a carrot every 0.5 time units
     assert PAPER.with_overrides(controller="anicov", robot_radius=0.5, stations=True).has_terrain
     with pytest.raises(ScenarioError, match="'stations': false flies anicov's weaving spiral, which knows no walls"):
         PAPER.with_overrides(controller="anicov", robot_radius=0.5, stations=False)
-    with pytest.raises(ScenarioError, match="'planning'"):
-        PAPER.with_overrides(controller="anicov", planning="local")
+    assert PAPER.with_overrides(controller="anicov", planning="local").planning == "local"  # issue 36, item 3
+    assert PAPER.with_overrides(controller="anicov", robot_radius=0.5, stations=True, planning="local").has_terrain
+
+
+@pytest.mark.parametrize("radius", [0.0, 0.5], ids=["open", "bodies"])
+def test_every_robot_cuts_the_same_routes_at_its_first_local_plan_whoever_it_hears(radius):
+    """planning = "local": a robot that hears no teammate at its first plan cuts the team's routes from their
+    seeded start poses, which are where they stand: the routes are the ones the whole team's plan cuts."""
+    scenario = PAPER.with_overrides(
+        domain=[40.0, 40.0], agents=3, controller="anicov", robot_radius=radius, stations=True
+    )
+    start = initial_poses(scenario)[:, :2]
+    lack = np.ones(scenario.grid_shape)
+    team = LanePlanner(scenario)
+    team.plan(lack, start)
+    for me in range(3):
+        alone = LanePlanner(scenario)
+        alone.plan(lack, start[[me]], [me])
+        for agent in range(3):
+            assert np.array_equal(alone.routes[agent].points, team.routes[agent].points)

@@ -19,6 +19,17 @@ def small(paper_scenario):
     return paper_scenario.with_overrides(domain=[40.0, 40.0], agents=4, seed=2)
 
 
+@pytest.fixture
+def rooms(paper_scenario):
+    """Two rooms joined by a door (24 × 16), four robots with bodies and the filter, anicov."""
+    return paper_scenario.with_overrides(
+        domain=[24.0, 16.0], cell=1.0, range=5.0, robot_radius=0.4, occlusion=True, agents=4, seed=2,
+        controller="anicov", stations=True,
+        obstacles=[[[12.0, 0.0], [13.0, 0.0], [13.0, 6.0], [12.0, 6.0]],
+                   [[12.0, 10.0], [13.0, 10.0], [13.0, 16.0], [12.0, 16.0]]],
+    )  # fmt: skip
+
+
 @pytest.mark.parametrize("planning", ["central", "local"])
 def test_unlimited_range_equals_the_engine_byte_for_byte(small, planning):
     """Every replica holds every event of step k at step k + 1, and every local planner computes the
@@ -31,6 +42,22 @@ def test_unlimited_range_equals_the_engine_byte_for_byte(small, planning):
     assert ranged.trace.tobytes() == reference.trace.tobytes()
     assert ranged.errors.tobytes() == reference.errors.tobytes()
     assert [plan[2].tobytes() for plan in ranged.plans] == [plan[2].tobytes() for plan in reference.plans]
+
+
+def test_anicov_among_walls_plans_locally_as_centrally_with_an_unlimited_range(rooms):
+    """Issue 36, item 3: anicov with robot bodies and the filter, each robot planning on its own replica: with
+    every replica whole every robot's planner cuts the team's routes and advances them as the central one."""
+    reference = run_scenario(rooms)
+    ranged = run_ranged(
+        rooms.with_overrides(planning="local"), coverage_map_of(rooms), starting_poses(rooms), True, None
+    )
+    assert reference.completed and ranged.trace.tobytes() == reference.trace.tobytes()
+    assert [plan[2].tobytes() for plan in ranged.plans] == [plan[2].tobytes() for plan in reference.plans]
+
+
+def test_anicov_among_walls_plans_locally_on_a_limited_range_and_still_covers(rooms):
+    result = run_scenario(rooms.with_overrides(comm_range=5.0, planning="local"))
+    assert result.completed and result.radio is not None and result.radio["divergence_max"] > 0
 
 
 @pytest.mark.parametrize("planning", ["central", "local"])

@@ -106,7 +106,7 @@ def test_a_constructor_that_raises_is_named_when_the_scenario_is_read(plugin_dir
     [
         ({"controller": "anicov", "robot_radius": 0.3, "stations": False}, "'stations': false flies anicov's"),
         ({"controller": "zigzag", "obstacles": [[[1, 1], [2, 1], [2, 2]]]}, "'zigzag' knows no walls"),
-        ({"controller": "anicov", "planning": "local"}, "'anicov' plans for the whole team at once"),
+        ({"controller": "zigzag", "planning": "local"}, "'zigzag' plans for the whole team at once"),
         ({"controller": "{module}:Still", "robot_radius": 0.3}, "knows no walls or robot bodies"),
         ({"controller": "{module}:Still", "comm_range": 30.0}, "run the compiled controllers only"),
         (

@@ -7,6 +7,8 @@ import json
 import os
 import signal
 
+import pytest
+
 from logger.replay import summarise_recording
 from tests.teamrun import (
     anicov,
@@ -27,10 +29,25 @@ def agent_counts(run_dir, agents):
     return [json.loads((run_dir / "logs" / f"agent-{i}.counts.json").read_text()) for i in range(agents)]
 
 
-def test_lockstep_local_planning_equals_the_engine(tmp_path):
-    """Every agent runs Algorithms 1-2 on its own replica (identical in lockstep) when the coordinator would:
-    each takes the objective the central plan gives it, so the run is the engine's byte for byte."""
-    config = write_scenario(tmp_path / "s.toml", domain=[40.0, 40.0], agents=4, seed=3, planning="local")
+ROOMS = {
+    "domain": [24.0, 16.0], "cell": 1.0, "range": 5.0, "robot_radius": 0.4, "occlusion": True, "agents": 4, "seed": 2,
+    "controller": "anicov",
+    "obstacles": [[[12.0, 0.0], [13.0, 0.0], [13.0, 6.0], [12.0, 6.0]],
+                  [[12.0, 10.0], [13.0, 10.0], [13.0, 16.0], [12.0, 16.0]]],
+}  # fmt: skip
+"""Issue 36: anicov among walls with robot bodies and the filter, two rooms joined by a door."""
+
+
+@pytest.mark.parametrize(
+    "values",
+    [{"domain": [40.0, 40.0], "agents": 4, "seed": 3}, ROOMS],
+    ids=["paper-law", "anicov-among-walls"],
+)
+def test_lockstep_local_planning_equals_the_engine(tmp_path, values):
+    """Every agent runs the planner on its own replica (identical in lockstep) when the coordinator would: each
+    takes the objective the central plan gives it, so the run is the engine's byte for byte. anicov's planner
+    (issue 36, item 3) cuts the team's routes on every robot and keeps its patches and cleanups alike."""
+    config = write_scenario(tmp_path / "s.toml", **values, planning="local")
     engine = anicov("run", "--config", str(config), "--out", str(tmp_path / "engine"), "--quiet", "--no-record")
     assert engine.returncode == 0, engine.stderr
     central = anicov("run", "--config", str(config), "--out", str(tmp_path / "central"), "--quiet", "--no-record")
@@ -66,6 +83,23 @@ def test_realtime_limited_range_with_local_planning_completes_and_ends_with_one_
     coordinator = json.loads((out / "coordinator_counts.json").read_text())
     assert {count["map_digest"] for count in counts} == {coordinator["map_digest"]}
     assert_bandwidth_is_reported(out, launched.stdout, counts)
+    assert processes_of(team) == []
+
+
+def test_realtime_local_planning_with_anicov_among_walls_completes_and_ends_with_one_map(tmp_path):
+    """Issue 36, item 3: anicov among walls in realtime, every robot planning on its own replica (the routes cut
+    alike from the start poses, carrots every half time unit): the team completes, and every replica ends the
+    coordinator's map."""
+    config = write_scenario(tmp_path / "s.toml", **ROOMS, planning="local")
+    team, out = unique_team(), tmp_path / "team"
+    command = launcher_command(
+        "--config", str(config), "--out", str(out), "--clock", "realtime", "--no-record", team=team
+    )
+    launched = run(command, timeout=400)
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "coverage        complete" in launched.stdout
+    coordinator = json.loads((out / "coordinator_counts.json").read_text())
+    assert {count["map_digest"] for count in agent_counts(out, 4)} == {coordinator["map_digest"]}
     assert processes_of(team) == []
 
 

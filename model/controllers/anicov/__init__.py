@@ -1,8 +1,10 @@
 """anicov's own controller (docs/controller.md): robots stand at stations and turn their camera through
 bearings chosen by a linear programme, hopping between them (``stations = false``: a weaving spiral then
 passes over what is left), steered by a carrot every :data:`route.CARROT_PERIOD`. Among walls and with robot
-bodies it flies stations only (:mod:`model.controllers.anicov.terrain_plan` and what follows it); its routes
-are cut for the whole team at once (no local planning)."""
+bodies it flies stations only (:mod:`model.controllers.anicov.terrain_plan` and what follows it). With
+``planning = "local"`` each robot runs this planner on its own replica: every one cuts the same routes for
+the whole team from the start poses (a teammate out of radio contact at its seeded one), and later plans
+advance, patch and clean up for the teammates it hears; each robot follows only its own carrot."""
 
 from __future__ import annotations
 
@@ -21,7 +23,7 @@ class AnicovController(Controller):
     """Stations (or the weaving spiral) planned by :class:`LanePlanner`, flown by pure pursuit."""
 
     name: ClassVar[str] = "anicov"
-    supports: ClassVar[Supports] = Supports(terrain=True, local_planning=False, team=True)
+    supports: ClassVar[Supports] = Supports(terrain=True, local_planning=True, team=True)
 
     def refuses(self, scenario: Scenario) -> str | None:
         if scenario.has_terrain and not scenario.stations:

@@ -66,6 +66,7 @@ from model.controllers.anicov.terrain_lanes import terrain_routes
 from model.controllers.anicov.touch_ups import TouchUp, blob_labels, with_touch_ups
 from model.controllers.anicov.weave import sweep_of
 from model.paper.objectives import BlobObjectives
+from model.parameters import initial_poses
 from model.planning import TeamPlanner
 from model.scenario import Scenario
 
@@ -194,8 +195,9 @@ class LanePlanner(TeamPlanner):
         return max(1, round(self.spacing / self.scenario.cell))
 
     def _all(self, ids: list[int], positions: np.ndarray) -> np.ndarray:
-        """Every robot's position at the first plan (a robot not among the members: the domain's centre)."""
-        where = np.tile(np.array(self.scenario.domain) / 2.0, (self.scenario.agents, 1))
+        """Every robot's position at the first plan; a robot not among the members (planning = "local", out of
+        radio contact) at its seeded start pose, so that every robot cuts the same routes for the team."""
+        where = initial_poses(self.scenario)[:, :2].copy()
         for index, agent in enumerate(ids):
             where[agent] = positions[index]
         return where

@@ -53,6 +53,12 @@ MOST_PERIODS = 48
 NODE_LIMIT = 2000
 """Branch-and-bound nodes HiGHS may explore for the cleanup's programme: a limit of work, not of time, so that
 every machine finds the same stations."""
+LARGE_PROGRAMME = 300
+"""Stares (variables) above which the programme is large and gets :data:`LARGE_NODE_LIMIT` nodes: each node's
+relaxation costs more, and more nodes gain little. The studies' cleanups have at most 135 (campus N = 8); a
+robot planning on a replica that missed its teammates' steps (a limited radio) met 556 - 704, at 23 - 55 s
+each with NODE_LIMIT; on the 556 one 200 nodes found 799 periods in 9.5 s, 10 nodes 803 in 2.3 s."""
+LARGE_NODE_LIMIT = 20
 PATCH_REACH = 0.25
 """A station patches a short cell only where one period of its stare brings at least this share of what the
 cell lacks."""
@@ -167,8 +173,8 @@ def _merged(stations: np.ndarray, periods: np.ndarray) -> tuple[np.ndarray, np.n
 def _fewest_stations(demand: csc_matrix, wanted: np.ndarray, scenario: Scenario) -> np.ndarray:
     """Whole periods per stare (column of ``demand``, station by station, bearing by bearing) that bring each
     row to ``wanted`` for the least time: the periods, plus :data:`STATION_HOPS` hops of R at k_v for every
-    station used (HiGHS's branch and bound, on at most :data:`NODE_LIMIT` nodes: the same answer on any
-    machine; the relaxed programme made whole where it finds none)."""
+    station used (HiGHS's branch and bound, on at most :data:`NODE_LIMIT` nodes, :data:`LARGE_NODE_LIMIT` for a
+    large programme: the same answer on any machine; the relaxed programme made whole where it finds none)."""
     useful = np.flatnonzero(np.diff(demand.indptr) > 0)  # stares that reach a short cell
     owner = useful // len(ANGLES)
     stations, station_of = np.unique(owner, return_inverse=True)
@@ -183,9 +189,10 @@ def _fewest_stations(demand: csc_matrix, wanted: np.ndarray, scenario: Scenario)
     low = np.concatenate([wanted, np.full(used, -np.inf)])
     high = np.concatenate([np.full(len(wanted), np.inf), np.zeros(used)])
     bounds = Bounds(np.zeros(count + used), np.concatenate([np.full(count, MOST_PERIODS), np.ones(used)]))
+    node_limit = NODE_LIMIT if count <= LARGE_PROGRAMME else LARGE_NODE_LIMIT
     solved = milp(
         cost, constraints=LinearConstraint(rows, low, high), integrality=np.ones(count + used),
-        bounds=bounds, options={"node_limit": NODE_LIMIT, "mip_rel_gap": 0.02},
+        bounds=bounds, options={"node_limit": node_limit, "mip_rel_gap": 0.02},
     )  # fmt: skip
     periods = np.zeros(demand.shape[1])
     if solved.x is not None:
