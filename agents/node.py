@@ -292,7 +292,7 @@ class AgentNode:
                 v,
                 omega,
                 me,
-                self.poses,
+                self.radio.beyond_reach(self.poses),
                 self.pose_ages(),
                 self.kinds,
                 self.ground,

@@ -29,6 +29,8 @@ class RadioLink:
         self.me = me
         self.heard_live = np.full(scenario.agents, -np.inf)  # when each teammate was last heard (monotonic)
         self.out_of_range = 0  # teammates' steps the radio did not deliver
+        # Whose latest step came from beyond comm_range: the safety filter leaves them out (see beyond_reach).
+        self.last_beyond = np.zeros(scenario.agents, dtype=bool)
         # Local planning: the robot's own planner, with its own progress watchdog (model.watchdog).
         local = scenario.planning == "local"
         self.planner = watched_planner(scenario, controller_of(scenario).planner(scenario)) if local else None
@@ -49,12 +51,27 @@ class RadioLink:
         """The receiver's radio filter: a teammate's step (or hello) arrives only from within ``comm_range``
         (its pose at that step against ours, ``pose``, now). Heard, it counts as contact."""
         if math.isfinite(self.scenario.comm_range):
-            if math.hypot(state.pose[0] - pose[0], state.pose[1] - pose[1]) > self.scenario.comm_range:
+            beyond = math.hypot(state.pose[0] - pose[0], state.pose[1] - pose[1]) > self.scenario.comm_range
+            if 0 <= state.agent < len(self.last_beyond):
+                self.last_beyond[state.agent] = beyond
+            if beyond:
                 self.out_of_range += 1
                 return False
         if 0 <= state.agent < len(self.heard_live):
             self.heard_live[state.agent] = time.monotonic()
         return True
+
+    def beyond_reach(self, poses: np.ndarray) -> np.ndarray:
+        """The teammates' poses for the safety filter, a teammate whose latest step came from beyond comm_range
+        left out (NaN). Its last heard pose ages while it is away, and the filter stops a robot for a pose in
+        reach older than max_pose_age: a teammate that walked out of range stopped the team for ever. Its
+        steps still come, dropped by the range: it is farther than comm_range, which is at least safety_range
+        (the scenario check), the filter's reach."""
+        if not self.last_beyond.any():
+            return poses
+        seen = poses.copy()
+        seen[self.last_beyond] = np.nan
+        return seen
 
     def in_contact(self) -> list[int]:
         """Teammates heard live within the last CONTACT_SECONDS, by id."""
