@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numba import njit
@@ -22,13 +23,13 @@ from numba.typed import List
 
 from anicov.plugin_engine import advance_plugin_team
 from anicov.radio_engine import run_ranged
-from anicov.run_parts import finish_run, objective_fields
+from anicov.run_parts import Snapshots, finish_run, objective_fields
 from model.controllers import controller_of, law_parameters
 from model.controllers.interface import Pilot
 from model.paper.coverage_map import CoverageMap, add_window
 from model.parameters import coverage_map_of, safety_parameters, starting_poses
 from model.planning import watched_planner
-from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack, snapshot_steps
+from model.run import TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack, snapshot_steps
 from model.safety.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move, sense_only
@@ -108,23 +109,21 @@ def run_scenario(
     coverage_map = coverage_map_of(scenario)
     poses = starting_poses(scenario) if poses is None else np.array(poses, dtype=np.float64)
     controller = controller_of(scenario)
-    if (pilots := controller.pilots(scenario, poses)) is not None:
-        return _run_pilots(scenario, coverage_map, poses, pilots, record_trace, progress)
-    if math.isfinite(scenario.comm_range) or scenario.planning == "local":
-        return run_ranged(scenario, coverage_map, poses, record_trace, progress)
+    advance = advance_team if controller.compiled else functools.partial(advance_plugin_team, controller, scenario)
+    elsewhere = _another_engine(scenario, coverage_map, poses, advance, record_trace, progress)
+    if elsewhere is not None:
+        return elsewhere
     law, world = controller.law(scenario, coverage_map.target_ticks), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     looks = np.full((scenario.agents, 2), np.nan)  # nothing looked at yet (model.step.no_look)
     planner, block = watched_planner(scenario, controller.planner(scenario)), controller.plan_steps(scenario)
-    advance = advance_team if controller.compiled else functools.partial(advance_plugin_team, controller, scenario)
     agents, traces = scenario.agents, []
     errors: list[np.ndarray] = [np.array([coverage_map.domain_error()])]
-    snapshot_times, snapshots = [0.0], [quantised_lack(coverage_map.lack_of_coverage())]
+    snapshots = Snapshots.start(coverage_map)
     scratch_trace = np.zeros((block, agents, len(TRACE_FIELDS)))
     scratch_errors = np.zeros(block)
     scratch_flags = np.zeros((block, agents), dtype=np.uint8)
     flags, plans, steps_done = [], [], 0
-    next_snapshot = SNAPSHOT_PERIOD
     while steps_done < scenario.max_steps and not coverage_map.complete:
         lack = coverage_map.lack_of_coverage()
         if planner.only_given_up_left(lack):
@@ -146,18 +145,36 @@ def run_scenario(
         errors.append(scratch_errors[:done].copy())
         steps_done += done
         now = steps_done * scenario.dt
-        if now >= next_snapshot - 1e-9 or coverage_map.complete:
-            snapshot_times.append(now)
-            snapshots.append(quantised_lack(coverage_map.lack_of_coverage()))
-            next_snapshot += SNAPSHOT_PERIOD
+        snapshots.take_if_due(now, coverage_map)
         if progress is not None:
             progress(now, coverage_map.domain_error())
     result = finish_run(
-        scenario, coverage_map, poses, traces, errors, steps_done, snapshot_times, snapshots, record_trace
+        scenario, coverage_map, poses, traces, errors, steps_done, snapshots.times, snapshots.lacks, record_trace
     )
     result.plans, result.stalls, result.given_up = plans, list(planner.stalls), planner.given_up()
     result.safety_flags = np.concatenate(flags) if flags else np.zeros((0, agents), dtype=np.uint8)
     return result
+
+
+def _another_engine(
+    scenario: Scenario,
+    coverage_map: CoverageMap,
+    poses: np.ndarray,
+    advance: Callable[..., tuple[int, int, int]],
+    record_trace: bool,
+    progress: ProgressCallback | None,
+) -> RunResult | None:
+    """The run, where another engine makes it: paths planned once (the zig-zags), a limited radio or local
+    planning (:mod:`anicov.radio_engine`), a physics world (:mod:`anicov.physics_engine`); else None."""
+    if (pilots := controller_of(scenario).pilots(scenario, poses)) is not None:
+        return _run_pilots(scenario, coverage_map, poses, pilots, record_trace, progress)
+    if math.isfinite(scenario.comm_range) or scenario.planning == "local":
+        return run_ranged(scenario, coverage_map, poses, record_trace, progress)
+    if scenario.physics == "mujoco":
+        from anicov.physics_engine import run_physics  # imports MuJoCo: only where a run asks for it
+
+        return run_physics(scenario, coverage_map, poses, advance, record_trace, progress)
+    return None
 
 
 def _run_pilots(

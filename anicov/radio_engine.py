@@ -17,13 +17,13 @@ import copy
 
 import numpy as np
 
-from anicov.run_parts import finish_run, objective_fields
+from anicov.run_parts import Snapshots, finish_run, objective_fields
 from model.controllers import controller_of, law_parameters
 from model.paper.coverage_map import CoverageMap
 from model.parameters import safety_parameters
 from model.planning import Plan, WatchedPlanner, watched_planner
 from model.radio.radio import contacts, divergence, local_members, merge_knowledge
-from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, ProgressCallback, RunResult, quantised_lack
+from model.run import TRACE_FIELDS, ProgressCallback, RunResult
 from model.safety.safety import MEMORY_SIZE, SafetyParameters, filter_command
 from model.scenario import Scenario
 from model.step import LawParameters, decide_and_sense, move
@@ -102,10 +102,10 @@ def run_ranged(
     central = watched_planner(scenario, controller.planner(scenario))
     planners = [watched_planner(scenario, controller.planner(scenario)) for _ in range(agents)]
     rows, flags, errors = [], [], [coverage_map.domain_error()]
-    snapshot_times, snapshots = [0.0], [quantised_lack(coverage_map.lack_of_coverage())]
+    snapshots = Snapshots.start(coverage_map)
     plans: list[Plan] = []
     objectives, fields = np.zeros((agents, 2)), np.zeros((agents, 1, 1))
-    next_snapshot, step = SNAPSHOT_PERIOD, 0
+    step = 0
     while step < scenario.max_steps and not coverage_map.complete:
         positions = poses[:, :2].copy()
         in_contact = contacts(positions, scenario.comm_range)
@@ -126,17 +126,12 @@ def run_ranged(
         flags.append(flag_row)
         errors.append(coverage_map.domain_error())
         step += 1
-        now = step * scenario.dt
-        if now >= next_snapshot - 1e-9 or coverage_map.complete:
-            snapshot_times.append(now)
-            snapshots.append(quantised_lack(coverage_map.lack_of_coverage()))
-            next_snapshot += SNAPSHOT_PERIOD
-            if progress is not None:
-                progress(now, coverage_map.domain_error())
+        if snapshots.take_if_due(step * scenario.dt, coverage_map) and progress is not None:
+            progress(step * scenario.dt, coverage_map.domain_error())
     trace = np.stack(rows) if rows else np.zeros((0, agents, len(TRACE_FIELDS)))
     chunks = [trace] if record_trace else [np.abs(trace[:, :, 3]).sum(axis=0)[None, :, None]]
     result = finish_run(
-        scenario, coverage_map, poses, chunks, [np.array(errors)], step, snapshot_times, snapshots, record_trace
+        scenario, coverage_map, poses, chunks, [np.array(errors)], step, snapshots.times, snapshots.lacks, record_trace
     )
     result.plans = plans
     result.stalls, result.given_up = watchdog_outcome(scenario, central, planners)

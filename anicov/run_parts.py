@@ -1,14 +1,16 @@
-"""What both in-process engines (:mod:`anicov.engine`, :mod:`anicov.radio_engine`) need around their
-steps: the objectives' distance fields, and the :class:`RunResult` made of the chunks of a run."""
+"""What the in-process engines (:mod:`anicov.engine`, :mod:`anicov.radio_engine`, :mod:`anicov.physics_engine`)
+need around their steps: the objectives' distance fields, the map's snapshots, and the :class:`RunResult`
+made of the chunks of a run."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from model.paper.coverage_map import CoverageMap
-from model.run import TRACE_FIELDS, RunResult
+from model.run import SNAPSHOT_PERIOD, TRACE_FIELDS, RunResult, quantised_lack
 from model.scenario import Scenario
 from model.world.world import World
 
@@ -18,6 +20,29 @@ def objective_fields(world: World, objectives: np.ndarray) -> np.ndarray:
     if not world.ground.walls:
         return np.zeros((len(objectives), 1, 1))
     return np.stack([world.field(*target) for target in objectives])
+
+
+@dataclass
+class Snapshots:
+    """Υ every SNAPSHOT_PERIOD time units and at completion, from Υ at t_0: what the recording and the plots
+    show of the map's progress."""
+
+    times: list[float] = field(default_factory=list)
+    lacks: list[np.ndarray] = field(default_factory=list)
+    next_at: float = SNAPSHOT_PERIOD
+
+    @classmethod
+    def start(cls, coverage_map: CoverageMap) -> Snapshots:
+        return cls([0.0], [quantised_lack(coverage_map.lack_of_coverage())])
+
+    def take_if_due(self, now: float, coverage_map: CoverageMap) -> bool:
+        """A snapshot at ``now`` if one is due (or the map is complete); whether one was taken."""
+        if now < self.next_at - 1e-9 and not coverage_map.complete:
+            return False
+        self.times.append(now)
+        self.lacks.append(quantised_lack(coverage_map.lack_of_coverage()))
+        self.next_at += SNAPSHOT_PERIOD
+        return True
 
 
 def finish_run(

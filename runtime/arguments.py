@@ -89,6 +89,11 @@ def scenario_from_arguments(args: argparse.Namespace) -> Scenario:
             f"scenario key 'controller': '{scenario.controller}' flies paths planned once for the team and runs "
             "in process only (anicov run, anicov sweep)"
         )
+    if hasattr(args, "clock") and scenario.physics != "kinematic":  # a team command, its clock settled or not
+        raise ScenarioError(
+            f"scenario key 'physics': '{scenario.physics}' runs in process only so far (anicov run, anicov sweep); a "
+            "team over Zenoh moves its robots by eq. 1 or drives ROS 2 bases (--robot ros2)"
+        )
     if getattr(args, "no_coordinator", False):
         check_no_coordinator(scenario, getattr(args, "clock", None))
     check_world(scenario)

@@ -75,6 +75,9 @@ def summary_of(result: RunResult) -> dict[str, Any]:
         summary["terrain"] = world.summary()
     if result.radio is not None:
         summary["radio"] = result.radio
+    if result.physics is not None:
+        summary["physical_contacts"] = result.physics["physical_contacts"]
+        summary["physics"] = result.physics
     if result.stalls or not result.completed:
         summary["watchdog"] = watchdog_report(result, world)
     if scenario.robot_radius > 0.0 and len(result.trace) == result.steps + 1:  # filter on or off, to compare

@@ -14,6 +14,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from model.scenario.physics_keys import PHYSICS_DEFAULTS, PhysicsKeyError, check_physics, resolve_physics_key
 from model.scenario.radio_keys import RADIO_DEFAULTS, RadioKeyError, check_radio, resolve_radio_key
 from model.scenario.safety_keys import SAFETY_DEFAULTS, SafetyKeyError, check_safety, resolve_safety_key
 from model.scenario.terrain import TerrainError
@@ -73,6 +74,9 @@ class Scenario:
     # Units (issue 15): what a length and a time unit are on a real robot (ROS: metres, seconds).
     metres_per_unit: float = 1.0
     seconds_per_unit: float = 1.0
+    # Physics (issue 37, model/scenario/physics_keys.py): the default is eq. 1, exactly.
+    physics: str = "kinematic"
+    robot: tuple[tuple[str, float], ...] = ()  # [robot]: the base's parameters, (name, value) sorted
 
     @property
     def half_angle(self) -> float:
@@ -107,9 +111,11 @@ class Scenario:
         for key in TERRAIN_KEYS:
             if getattr(self, key) == getattr(_OPEN_WORLD, key) or (key == "occlusion" and not self.has_terrain):
                 del values[key]
-        for key in ("weave", "stations", "watchdog", "watchdog_time", *UNIT_KEYS, *RADIO_DEFAULTS):
+        for key in ("weave", "stations", "watchdog", "watchdog_time", *UNIT_KEYS, *RADIO_DEFAULTS, *PHYSICS_DEFAULTS):
             if getattr(self, key) == getattr(_OPEN_WORLD, key):
                 del values[key]
+        if self.robot:
+            values["robot"] = dict(self.robot)
         for key in SAFETY_DEFAULTS:
             unused = key not in ("initial_poses", "objectives") and not self.robot_radius > 0.0
             if getattr(self, key) == SAFETY_DEFAULTS[key] or unused:
@@ -197,16 +203,8 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
     for key, value in values.items():
         if key in TERRAIN_KEYS:
             resolved[key] = value
-        elif key in SAFETY_DEFAULTS:
-            try:
-                resolved[key] = resolve_safety_key(key, value)
-            except SafetyKeyError as error:
-                raise ScenarioError(str(error)) from error
-        elif key in RADIO_DEFAULTS:
-            try:
-                resolved[key] = resolve_radio_key(key, value)
-            except RadioKeyError as error:
-                raise ScenarioError(str(error)) from error
+        elif key in SAFETY_DEFAULTS or key in RADIO_DEFAULTS or key in PHYSICS_DEFAULTS:
+            resolved[key] = _grouped_key(key, value)
         elif key == "domain":
             resolved[key] = _domain(value)
         elif key in ("agents", "seed"):
@@ -241,6 +239,18 @@ def validate(values: dict[str, Any], base: Path | None = None) -> Scenario:
     return _check_whole(replace(Scenario(), **resolved))
 
 
+def _grouped_key(key: str, value: Any) -> Any:
+    """A key of the safety, radio or physics group, resolved by its own module."""
+    try:
+        if key in SAFETY_DEFAULTS:
+            return resolve_safety_key(key, value)
+        if key in RADIO_DEFAULTS:
+            return resolve_radio_key(key, value)
+        return resolve_physics_key(key, value)
+    except (SafetyKeyError, RadioKeyError, PhysicsKeyError) as error:
+        raise ScenarioError(str(error)) from error
+
+
 def _check_whole(scenario: Scenario) -> Scenario:
     """The checks that read several keys at once."""
     unsupported = _registry().check_supports(scenario)
@@ -254,7 +264,8 @@ def _check_whole(scenario: Scenario) -> Scenario:
     try:
         check_safety(scenario)
         check_radio(scenario)
-    except (SafetyKeyError, RadioKeyError) as error:
+        check_physics(scenario)
+    except (SafetyKeyError, RadioKeyError, PhysicsKeyError) as error:
         raise ScenarioError(str(error)) from error
     rows, cols = scenario.grid_shape
     for axis, cells, size in (("width", cols, scenario.domain[0]), ("height", rows, scenario.domain[1])):

@@ -1,0 +1,77 @@
+"""The physics keys of a scenario (issue 37): what moves the robots.
+
+- ``physics``: ``"kinematic"`` (default: eq. 1 integrated exactly, every existing run) or ``"mujoco"``: a
+  MuJoCo world (:mod:`model.physics`) in which each robot is a body of ``robot_radius`` on two wheels driven
+  at the speeds that make the commanded (v, ω), within the base's torque; walls and obstacles are static
+  geometry, and contacts between bodies are counted.
+- ``[robot]``, the base's parameters, each optional (the defaults, :func:`model.physics.base.base_of`, scale
+  a TurtleBot3 Burger, r = 0.105 m, to the scenario's ``robot_radius`` and ``k_v``):
+  ``mass`` (kg, default 1.0), ``wheel_radius`` (default 0.31 r), ``wheel_separation`` (centre to centre,
+  default 1.52 r), ``acceleration`` (the most the wheels' torque gives the base, units per time unit²;
+  default 11 k_v, the Burger's 2.5 m/s² at 0.22 m/s), ``friction`` (the wheels' on the floor, default 1.0).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+PHYSICS_DEFAULTS: dict[str, Any] = {"physics": "kinematic", "robot": ()}
+PHYSICS = ("kinematic", "mujoco")
+ROBOT_KEYS = ("mass", "wheel_radius", "wheel_separation", "acceleration", "friction")
+
+
+class PhysicsKeyError(ValueError):
+    """A physics key with a value that cannot be used; the message names the key."""
+
+
+def resolve_physics_key(key: str, value: Any) -> Any:
+    """One physics key's value, checked and typed; ``robot`` becomes sorted (name, value) pairs."""
+    if key == "physics":
+        if value not in PHYSICS:
+            raise PhysicsKeyError(f"scenario key 'physics': expected one of {', '.join(PHYSICS)}, got {value!r}")
+        return value
+    if isinstance(value, tuple) and all(isinstance(pair, tuple) and len(pair) == 2 for pair in value):
+        value = dict(value)  # already resolved (Scenario.with_overrides)
+    if not isinstance(value, dict):
+        raise PhysicsKeyError(f"scenario key 'robot': expected a table of {', '.join(ROBOT_KEYS)}, got {value!r}")
+    pairs = []
+    for name, number in value.items():
+        if name not in ROBOT_KEYS:
+            raise PhysicsKeyError(f"unknown scenario key 'robot.{name}': expected one of {', '.join(ROBOT_KEYS)}")
+        if isinstance(number, bool) or not isinstance(number, int | float) or not number > 0 or number == float("inf"):
+            raise PhysicsKeyError(f"scenario key 'robot.{name}': expected a positive number, got {number!r}")
+        pairs.append((name, float(number)))
+    return tuple(sorted(pairs))
+
+
+def check_physics(scenario: Any) -> None:
+    """The checks that need the whole scenario; raises PhysicsKeyError."""
+    if scenario.physics == "kinematic":
+        if scenario.robot:
+            raise PhysicsKeyError(
+                "scenario key 'robot': the base's parameters are read by physics = \"mujoco\" only; "
+                'set physics = "mujoco" or leave the [robot] table out'
+            )
+        return
+    if not scenario.robot_radius > 0.0:
+        raise PhysicsKeyError(
+            "scenario key 'physics': 'mujoco' simulates robot bodies: expected robot_radius > 0, got "
+            f"{scenario.robot_radius}"
+        )
+    if scenario.planning == "local" or scenario.comm_range != float("inf"):
+        raise PhysicsKeyError(
+            "scenario key 'physics': 'mujoco' runs with planning = \"central\" and an unlimited radio (comm_range "
+            "left out) so far"
+        )
+    robot = dict(scenario.robot)
+    separation = robot.get("wheel_separation", 1.52 * scenario.robot_radius)
+    if separation >= 2.0 * scenario.robot_radius:
+        raise PhysicsKeyError(
+            f"scenario key 'robot.wheel_separation': expected less than the body's diameter "
+            f"2 robot_radius = {2.0 * scenario.robot_radius}, got {separation}"
+        )
+    if robot.get("wheel_radius", 0.31 * scenario.robot_radius) >= scenario.robot_radius:
+        raise PhysicsKeyError(
+            f"scenario key 'robot.wheel_radius': expected less than robot_radius {scenario.robot_radius}, "
+            f"got {robot['wheel_radius']}"
+        )
