@@ -5,6 +5,12 @@ command, the deltas are added), one step at a time; then, in place of eq. 1, one
 (:class:`model.physics.world.PhysicsWorld`) drives every robot's wheels at its command for the period and
 gives the poses of t_{k+1}. The plans come every ``plan_steps`` as in the engine. The contacts the world
 counted are the run's ``physical_contacts`` (summary.json).
+
+With ``[noise]`` (:mod:`model.physics.noise`) the robots decide, sense and filter from what they believe of
+their poses, and their commands reach the wheels late. The truth is kept beside the belief: the true poses
+(``truth.csv``), and the coverage their cameras really gave, by the same sensor rule from the true poses, on a
+map of its own; ``true_coverage`` is its share of the coverable cells at Λ* when the team declared the run
+complete, ``true_cells_short`` what it left.
 """
 
 from __future__ import annotations
@@ -16,14 +22,51 @@ import numpy as np
 from anicov.run_parts import Snapshots, finish_run, objective_fields
 from model.controllers import controller_of
 from model.paper.coverage_map import CoverageMap
-from model.parameters import safety_parameters
+from model.parameters import coverage_map_of, safety_parameters
 from model.physics.base import base_of
+from model.physics.noise import Belief, CommandDelay, noise_of
 from model.physics.world import PhysicsWorld
 from model.planning import watched_planner
 from model.run import TRACE_FIELDS, ProgressCallback, RunResult
 from model.safety.safety import MEMORY_SIZE
 from model.scenario import Scenario
+from model.step import LawParameters, sense_only
+from model.world.ground import Ground
 from model.world.world import world_of
+
+
+class PhysicalTeam:
+    """The world, what the robots believe of their poses, their late commands, and the truth's own map."""
+
+    def __init__(self, scenario: Scenario, poses: np.ndarray, ground: Ground) -> None:
+        noise = noise_of(scenario)
+        self.world = PhysicsWorld(scenario.domain, ground, base_of(scenario), poses, scenario.dt)
+        self.truth = self.world.poses()
+        self.belief = Belief(noise, self.truth, scenario.seed)
+        self.delay = CommandDelay(noise.command_delay, scenario.agents)
+        self.true_map = coverage_map_of(scenario)
+        self.true_poses = [self.truth.copy()]
+
+    def move(self, commands: np.ndarray, law: LawParameters, ground: Ground) -> np.ndarray:
+        """The cameras sense from the true poses of t_k, the wheels take the commands due, the world steps;
+        the believed poses of t_{k+1}."""
+        positions = self.truth[:, :2].copy()
+        for i, (x, y, theta) in enumerate(self.truth):
+            self.true_map.add(*sense_only(self.true_map.coverage, x, y, theta, law, ground, positions, i))
+        self.truth = self.world.step(self.delay(commands))
+        self.true_poses.append(self.truth.copy())
+        return self.belief.update(self.truth)
+
+    def figures(self) -> dict[str, float | int]:
+        """What summary.json reports of the physics and the truth."""
+        contacts, true_map = self.world.contacts, self.true_map
+        return {
+            "physical_contacts": contacts.total,
+            "robot_contacts": contacts.robots,
+            "wall_contacts": contacts.walls,
+            "true_coverage": 1.0 - true_map.uncovered_cells / true_map.counted_cells,
+            "true_cells_short": int(true_map.uncovered_cells),
+        }
 
 
 def run_physics(
@@ -41,7 +84,8 @@ def run_physics(
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     looks = np.full((scenario.agents, 2), np.nan)
     planner, block = watched_planner(scenario, controller.planner(scenario)), controller.plan_steps(scenario)
-    physics = PhysicsWorld(scenario.domain, world.ground, base_of(scenario), poses, scenario.dt)
+    team = PhysicalTeam(scenario, poses, world.ground)
+    poses[:] = team.truth  # the start poses as the world holds them (read back through its quaternions)
     agents = scenario.agents
     trace, errors_now = np.zeros((1, agents, len(TRACE_FIELDS))), np.zeros(1)
     flags_now = np.zeros((1, agents), dtype=np.uint8)
@@ -63,7 +107,7 @@ def run_physics(
             coverage_map.uncovered_cells, coverage_map.deficit_ticks,
             coverage_map.target_ticks * coverage_map.counted_cells, trace, errors_now, flags_now,
         )  # fmt: skip
-        poses[:] = physics.step(trace[0, :, 3:5])  # the world's poses, not eq. 1's
+        poses[:] = team.move(trace[0, :, 3:5], law, world.ground)  # believed, from the world's: not eq. 1's
         rows.append(trace.copy() if record_trace else np.abs(trace[:, :, 3]).reshape(1, agents, 1))
         flags.append(flags_now.copy())
         errors.append(errors_now.copy())
@@ -76,6 +120,5 @@ def run_physics(
     )
     result.plans, result.stalls, result.given_up = plans, list(planner.stalls), planner.given_up()
     result.safety_flags = np.concatenate(flags) if flags else np.zeros((0, agents), dtype=np.uint8)
-    result.physics = {"physical_contacts": physics.contacts.total, "robot_contacts": physics.contacts.robots,
-                      "wall_contacts": physics.contacts.walls}  # fmt: skip
+    result.physics, result.true_poses = team.figures(), np.stack(team.true_poses)
     return result

@@ -52,7 +52,8 @@ class RunResult:
     plans: list[Plan] = field(default_factory=list)  # every replan, for the recording
     safety_flags: np.ndarray | None = None  # (steps, N) uint8: what the safety filter did (model.safety.safety)
     radio: dict[str, float] | None = None  # a team on a limited radio (anicov.radio_engine.RadioTeam.figures)
-    physics: dict[str, int] | None = None  # physics = "mujoco": contacts counted (anicov.physics_engine)
+    physics: dict[str, float | int] | None = None  # physics = "mujoco": contacts, true coverage (anicov.physics_engine)
+    true_poses: np.ndarray | None = None  # physics = "mujoco": (steps + 1, N, 3) the true poses, beside the trace's
     stalls: list[Stall] = field(default_factory=list)  # the progress watchdog's interventions (model.watchdog)
     given_up: np.ndarray | None = None  # bool (rows, cols): cells the watchdog gave up
     timed_positions: dict[int, np.ndarray] | None = None  # realtime: agent → (M, 3) wall time, x, y after each step

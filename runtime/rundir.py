@@ -50,6 +50,24 @@ def write_trajectory(result: RunResult, path: Path) -> None:
     path.write_text("\n".join(lines) + "\n", encoding="ascii")
 
 
+TRUTH_HEADER = "t,agent,x,y,theta,x_believed,y_believed,theta_believed"
+
+
+def write_truth(result: RunResult, path: Path) -> None:
+    """physics = "mujoco": one row per agent per step, the true pose beside the believed one (the trace's), in
+    the map's frame like trajectory.csv."""
+    assert result.true_poses is not None
+    frame = map_frame_of(result.scenario)
+    lines = [TRUTH_HEADER]
+    for step, (truths, rows) in enumerate(zip(result.true_poses, result.trace, strict=False)):
+        t = repr(step_time(step, result.scenario.dt))
+        for agent, ((x, y, theta), believed) in enumerate(zip(truths.tolist(), rows[:, :3].tolist(), strict=True)):
+            (x, y), theta = frame.to_map(x, y), float(frame.heading_to_map(theta))
+            (bx, by), btheta = frame.to_map(believed[0], believed[1]), float(frame.heading_to_map(believed[2]))
+            lines.append(f"{t},{agent},{x!r},{y!r},{theta!r},{bx!r},{by!r},{btheta!r}")
+    path.write_text("\n".join(lines) + "\n", encoding="ascii")
+
+
 def summary_of(result: RunResult) -> dict[str, Any]:
     """The summary.json fields (see README)."""
     scenario = result.scenario
@@ -76,7 +94,8 @@ def summary_of(result: RunResult) -> dict[str, Any]:
     if result.radio is not None:
         summary["radio"] = result.radio
     if result.physics is not None:
-        summary["physical_contacts"] = result.physics["physical_contacts"]
+        for key in ("physical_contacts", "true_coverage", "true_cells_short"):
+            summary[key] = result.physics[key]
         summary["physics"] = result.physics
     if result.stalls or not result.completed:
         summary["watchdog"] = watchdog_report(result, world)
@@ -249,6 +268,8 @@ def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, obje
 
     out_dir.mkdir(parents=True, exist_ok=True)
     write_trajectory(result, out_dir / "trajectory.csv")
+    if result.true_poses is not None and len(result.trace) == len(result.true_poses):
+        write_truth(result, out_dir / "truth.csv")
     summary = summary_of(result)
     write_summary(summary, out_dir / "summary.json")
     if counts is not None:

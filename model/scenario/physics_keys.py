@@ -9,15 +9,30 @@
   ``mass`` (kg, default 1.0), ``wheel_radius`` (default 0.31 r), ``wheel_separation`` (centre to centre,
   default 1.52 r), ``acceleration`` (the most the wheels' torque gives the base, units per time unit²;
   default 11 k_v, the Burger's 2.5 m/s² at 0.22 m/s), ``friction`` (the wheels' on the floor, default 1.0).
+- ``[noise]`` (physics = "mujoco" only; every key optional, default 0: none), what a robot believes of its
+  pose (:mod:`model.physics.noise`): ``odometry_per_metre`` and ``odometry_per_radian`` (σ of the drift its
+  wheel odometry gathers per unit travelled and per radian turned), ``localiser_sigma`` and
+  ``localiser_heading_deg`` (σ of a localiser's fix), ``localiser_rate`` (fixes per time unit; 0: none),
+  ``localiser_latency`` (time units from the pose a fix measures to its arrival), ``command_latency`` (time
+  units from a command to the wheels). Seeded by the scenario's seed.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-PHYSICS_DEFAULTS: dict[str, Any] = {"physics": "kinematic", "robot": ()}
+PHYSICS_DEFAULTS: dict[str, Any] = {"physics": "kinematic", "robot": (), "noise": ()}
 PHYSICS = ("kinematic", "mujoco")
 ROBOT_KEYS = ("mass", "wheel_radius", "wheel_separation", "acceleration", "friction")
+NOISE_KEYS = (
+    "odometry_per_metre",
+    "odometry_per_radian",
+    "localiser_sigma",
+    "localiser_heading_deg",
+    "localiser_rate",
+    "localiser_latency",
+    "command_latency",
+)
 
 
 class PhysicsKeyError(ValueError):
@@ -30,16 +45,19 @@ def resolve_physics_key(key: str, value: Any) -> Any:
         if value not in PHYSICS:
             raise PhysicsKeyError(f"scenario key 'physics': expected one of {', '.join(PHYSICS)}, got {value!r}")
         return value
+    names, positive = (ROBOT_KEYS, True) if key == "robot" else (NOISE_KEYS, False)
     if isinstance(value, tuple) and all(isinstance(pair, tuple) and len(pair) == 2 for pair in value):
         value = dict(value)  # already resolved (Scenario.with_overrides)
     if not isinstance(value, dict):
-        raise PhysicsKeyError(f"scenario key 'robot': expected a table of {', '.join(ROBOT_KEYS)}, got {value!r}")
+        raise PhysicsKeyError(f"scenario key '{key}': expected a table of {', '.join(names)}, got {value!r}")
     pairs = []
     for name, number in value.items():
-        if name not in ROBOT_KEYS:
-            raise PhysicsKeyError(f"unknown scenario key 'robot.{name}': expected one of {', '.join(ROBOT_KEYS)}")
-        if isinstance(number, bool) or not isinstance(number, int | float) or not number > 0 or number == float("inf"):
-            raise PhysicsKeyError(f"scenario key 'robot.{name}': expected a positive number, got {number!r}")
+        if name not in names:
+            raise PhysicsKeyError(f"unknown scenario key '{key}.{name}': expected one of {', '.join(names)}")
+        bad = isinstance(number, bool) or not isinstance(number, int | float) or not 0 <= number < float("inf")
+        if bad or (positive and number == 0):
+            kind = "positive" if positive else "non-negative"
+            raise PhysicsKeyError(f"scenario key '{key}.{name}': expected a {kind} number, got {number!r}")
         pairs.append((name, float(number)))
     return tuple(sorted(pairs))
 
@@ -47,11 +65,12 @@ def resolve_physics_key(key: str, value: Any) -> Any:
 def check_physics(scenario: Any) -> None:
     """The checks that need the whole scenario; raises PhysicsKeyError."""
     if scenario.physics == "kinematic":
-        if scenario.robot:
-            raise PhysicsKeyError(
-                "scenario key 'robot': the base's parameters are read by physics = \"mujoco\" only; "
-                'set physics = "mujoco" or leave the [robot] table out'
-            )
+        for key, what in (("robot", "the base's parameters are"), ("noise", "pose noise is")):
+            if getattr(scenario, key):
+                raise PhysicsKeyError(
+                    f'scenario key \'{key}\': {what} read by physics = "mujoco" only; set physics = "mujoco" '
+                    f"or leave the [{key}] table out"
+                )
         return
     if not scenario.robot_radius > 0.0:
         raise PhysicsKeyError(

@@ -77,6 +77,7 @@ class Scenario:
     # Physics (issue 37, model/scenario/physics_keys.py): the default is eq. 1, exactly.
     physics: str = "kinematic"
     robot: tuple[tuple[str, float], ...] = ()  # [robot]: the base's parameters, (name, value) sorted
+    noise: tuple[tuple[str, float], ...] = ()  # [noise]: odometry, localiser and command latency, likewise
 
     @property
     def half_angle(self) -> float:
@@ -114,8 +115,9 @@ class Scenario:
         for key in ("weave", "stations", "watchdog", "watchdog_time", *UNIT_KEYS, *RADIO_DEFAULTS, *PHYSICS_DEFAULTS):
             if getattr(self, key) == getattr(_OPEN_WORLD, key):
                 del values[key]
-        if self.robot:
-            values["robot"] = dict(self.robot)
+        for key in ("robot", "noise"):
+            if getattr(self, key):
+                values[key] = dict(getattr(self, key))
         for key in SAFETY_DEFAULTS:
             unused = key not in ("initial_poses", "objectives") and not self.robot_radius > 0.0
             if getattr(self, key) == SAFETY_DEFAULTS[key] or unused:

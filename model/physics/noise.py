@@ -1,0 +1,138 @@
+"""What a robot believes of its pose (issue 37, item 2): wheel odometry that drifts, a localiser's late and
+noisy fixes, and commands that reach the wheels late.
+
+- **Odometry**: each period the belief moves by the true motion of the period (in the robot's own frame:
+  forward, sideways, turn), plus Gaussian drift of σ ``odometry_per_metre`` per unit travelled (forward and
+  sideways) and ``odometry_per_radian`` per radian turned.
+- **Localiser**: every 1 / ``localiser_rate`` time units it measures the true pose with σ
+  ``localiser_sigma`` (x, y) and ``localiser_heading_deg``; the fix arrives ``localiser_latency`` later and
+  replaces the belief of that moment, the odometry since then replayed on it (what a ROS 2 robot's
+  localisation does with a late fix and the odom → base_link transform).
+- **Commands** reach the wheels ``command_latency`` later, whole periods (:class:`CommandDelay`).
+
+Every draw comes from one generator seeded by the scenario's seed, in a fixed order: a run repeats exactly.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.scenario import Scenario
+
+NOISE_SEED_SALT = 37
+"""Mixed into the scenario's seed, so that the noise does not repeat the start poses' draw."""
+
+
+@dataclass(frozen=True)
+class Noise:
+    odometry_per_metre: float = 0.0
+    odometry_per_radian: float = 0.0
+    localiser_sigma: float = 0.0
+    localiser_heading: float = 0.0  # radians
+    localiser_period: int = 0  # control periods between fixes; 0: no localiser
+    localiser_delay: int = 0  # control periods from the pose a fix measures to its arrival
+    command_delay: int = 0  # control periods from a command to the wheels
+
+    @property
+    def none(self) -> bool:
+        """No noise at all: the belief is the truth."""
+        return self == Noise()
+
+
+def noise_of(scenario: Scenario) -> Noise:
+    """The scenario's ``[noise]`` table, its times in whole control periods."""
+    given = dict(scenario.noise)
+    rate = given.get("localiser_rate", 0.0)
+    return Noise(
+        odometry_per_metre=given.get("odometry_per_metre", 0.0),
+        odometry_per_radian=given.get("odometry_per_radian", 0.0),
+        localiser_sigma=given.get("localiser_sigma", 0.0),
+        localiser_heading=math.radians(given.get("localiser_heading_deg", 0.0)),
+        localiser_period=max(1, round(1.0 / (rate * scenario.dt))) if rate > 0.0 else 0,
+        localiser_delay=round(given.get("localiser_latency", 0.0) / scenario.dt),
+        command_delay=round(given.get("command_latency", 0.0) / scenario.dt),
+    )
+
+
+def in_own_frame(before: np.ndarray, after: np.ndarray) -> np.ndarray:
+    """(N, 3): each robot's motion from ``before`` to ``after`` (N, 3) in its frame at ``before``: forward,
+    sideways, turn."""
+    dx, dy = after[:, 0] - before[:, 0], after[:, 1] - before[:, 1]
+    cos, sin = np.cos(before[:, 2]), np.sin(before[:, 2])
+    turn = np.angle(np.exp(1j * (after[:, 2] - before[:, 2])))
+    return np.stack([cos * dx + sin * dy, -sin * dx + cos * dy, turn], axis=1)
+
+
+def moved_by(poses: np.ndarray, motion: np.ndarray) -> np.ndarray:
+    """``poses`` (N, 3) moved by ``motion`` (N, 3) given in each one's own frame (:func:`in_own_frame`)."""
+    cos, sin = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    x = poses[:, 0] + cos * motion[:, 0] - sin * motion[:, 1]
+    y = poses[:, 1] + sin * motion[:, 0] + cos * motion[:, 1]
+    return np.stack([x, y, np.angle(np.exp(1j * (poses[:, 2] + motion[:, 2])))], axis=1)
+
+
+class Belief:
+    """Every robot's believed pose, kept from the true poses the world gives each period (see the module)."""
+
+    def __init__(self, noise: Noise, truth: np.ndarray, seed: int) -> None:
+        self.noise = noise
+        self.rng = np.random.default_rng([seed, NOISE_SEED_SALT])
+        self.poses = truth.copy()  # the start pose is known
+        self.truth = truth.copy()
+        self.step = 0
+        keep = noise.localiser_delay + 1
+        self.odometry: deque[np.ndarray] = deque(maxlen=keep)  # the last periods' odometry motions
+        self.measured: deque[tuple[int, np.ndarray]] = deque()  # fixes taken, waiting for their arrival
+
+    def update(self, truth: np.ndarray) -> np.ndarray:
+        """The world's true poses after one more period; the beliefs (N, 3) then."""
+        motion = in_own_frame(self.truth, truth)
+        self.truth, self.step = truth.copy(), self.step + 1
+        if self.noise.none:
+            self.poses = truth.copy()
+            return self.poses
+        odometry = motion + self._drift(motion)
+        self.odometry.append(odometry)
+        self.poses = moved_by(self.poses, odometry)
+        noise = self.noise
+        if noise.localiser_period and self.step % noise.localiser_period == 0:
+            fix = truth + self.rng.normal(0.0, 1.0, truth.shape) * [
+                noise.localiser_sigma, noise.localiser_sigma, noise.localiser_heading
+            ]  # fmt: skip
+            self.measured.append((self.step + noise.localiser_delay, fix))
+        while self.measured and self.measured[0][0] <= self.step:
+            _, fix = self.measured.popleft()
+            self.poses = self._replayed(fix)
+        return self.poses
+
+    def _drift(self, motion: np.ndarray) -> np.ndarray:
+        travelled = np.abs(motion[:, :2]).sum(axis=1, keepdims=True)
+        sigma = np.hstack([
+            np.sqrt(travelled) * self.noise.odometry_per_metre * np.ones((len(motion), 2)),
+            np.sqrt(np.abs(motion[:, 2:3])) * self.noise.odometry_per_radian,
+        ])  # fmt: skip
+        return self.rng.normal(0.0, 1.0, motion.shape) * sigma
+
+    def _replayed(self, fix: np.ndarray) -> np.ndarray:
+        """A fix of the pose ``localiser_delay`` periods ago, the odometry since replayed on it."""
+        poses = np.array(fix)
+        poses[:, 2] = np.angle(np.exp(1j * poses[:, 2]))
+        for odometry in list(self.odometry)[len(self.odometry) - self.noise.localiser_delay :]:
+            poses = moved_by(poses, odometry)
+        return poses
+
+
+class CommandDelay:
+    """Commands (N, 2) reach the wheels ``delay`` periods after they are given; before the first arrives,
+    the wheels get zero."""
+
+    def __init__(self, delay: int, agents: int) -> None:
+        self.waiting: deque[np.ndarray] = deque([np.zeros((agents, 2))] * delay)
+
+    def __call__(self, commands: np.ndarray) -> np.ndarray:
+        self.waiting.append(np.array(commands))
+        return self.waiting.popleft()
