@@ -45,12 +45,21 @@ ARRIVE_CELLS = 1.0 / 16.0
 
 def face_radius_of(scenario: Scenario) -> float:
     """:data:`FACE_RADIUS` where the anicov controller's robots stand at stations (its default, ``stations``),
-    else 0: the one rule the planner's carrots and the robots' law both read."""
+    else 0: the one rule the planner's carrots and the robots' law both read. With a localiser's noise
+    (physics, ``[noise]``) at least :data:`NOISE_FACE_SIGMAS` of its σ: a robot inside its belief's jitter
+    has arrived."""
     if not scenario.stations:
         return 0.0
     if not scenario.has_terrain:
         return FACE_RADIUS
-    return FACE_RADIUS * scenario.k_v * scenario.dt / 0.1  # among walls, at the robot's units: half a step
+    face = FACE_RADIUS * scenario.k_v * scenario.dt / 0.1  # among walls, at the robot's units: half a step
+    return max(face, NOISE_FACE_SIGMAS * dict(scenario.noise).get("localiser_sigma", 0.0))
+
+
+NOISE_FACE_SIGMAS = 6.0
+"""A robot whose belief jitters by a localiser's σ chased it round each station: two rooms and a door, N = 4,
+σ = 0.05, took 567.3 time units against 161.9 without noise; with a face radius of 2, 4 and 6 σ, 292.6, 204.9
+and 194.0, true coverage 100 % each (the belief was off the truth by 0.248 at most, 5 σ)."""
 
 
 @dataclass
