@@ -263,6 +263,18 @@ class RunRecorder:
             self.domain_errors(data[:, 1], data[:, 0].astype(np.int64))
             self._pending_errors = []
 
+    def truth(self, true_poses: np.ndarray, believed: np.ndarray) -> None:
+        """physics = "mujoco": each robot's true position beside the believed one (``world/truth/<i>``, orange),
+        and how far apart they are (``truth/<i>/error``)."""
+        steps = np.arange(len(true_poses), dtype=np.int64)
+        indexes = [rr.TimeColumn("step", sequence=steps), rr.TimeColumn("sim_time", duration=steps * self.scenario.dt)]
+        for agent in range(true_poses.shape[1]):
+            points = self.to_map(true_poses[:, agent, 0], true_poses[:, agent, 1])
+            columns = rr.Points2D.columns(positions=points, colors=np.tile([255, 160, 0, 255], (len(steps), 1)))
+            self.stream.send_columns(f"world/truth/{agent}/position", indexes=indexes, columns=columns)
+            error = np.hypot(*(true_poses[:, agent, :2] - believed[:, agent, :2]).T)
+            self.stream.send_columns(f"truth/{agent}/error", indexes=indexes, columns=rr.Scalars.columns(scalars=error))
+
     def _send_bodies(self, agent: int, indexes: list, points: np.ndarray, flags: np.ndarray) -> None:
         """The robot's disk at every step, red while the safety filter acts; and the filter as a series."""
         active = (flags & FILTER_ACTIVE) != 0
@@ -367,6 +379,8 @@ def record_result(result, path: Path, recording_id: str, map_every: int = 50) ->
         recorder.lack_map(round(time / result.scenario.dt), snapshot / 255.0)  # 8-bit snapshots
     recorder.lack_map(result.steps, result.final_lack)
     recorder.domain_errors(result.errors)
+    if result.true_poses is not None and len(result.true_poses) == len(trace):
+        recorder.truth(result.true_poses, trace[:, :, :3])
     frame = map_frame_of(result.scenario)
     for stall in result.stalls:
         recorder.event(round(stall.time / result.scenario.dt), stall.line(result.scenario.cell, frame), level="WARN")

@@ -110,10 +110,32 @@ def draw_obstacles(
     ax.imshow(layers, origin="lower", extent=box, interpolation="nearest", transform=placed or ax.transData)
 
 
+def plot_truth(result: RunResult, path: Path) -> None:
+    """physics = "mujoco" with noise: each robot's true path (solid) beside its believed one (dashed), and how
+    far apart they were over time."""
+    assert result.true_poses is not None
+    truth, believed = result.true_poses, result.trace[: len(result.true_poses), :, :3]
+    times = np.arange(len(truth)) * result.scenario.dt
+    figure, (paths, gaps) = plt.subplots(1, 2, figsize=(12, 5))
+    for agent in range(truth.shape[1]):
+        line = paths.plot(truth[:, agent, 0], truth[:, agent, 1], linewidth=0.8, label=f"agent {agent}, true")[0]
+        paths.plot(believed[:, agent, 0], believed[:, agent, 1], "--", color=line.get_color(), linewidth=0.8)
+        gaps.plot(times, np.hypot(*(truth[:, agent, :2] - believed[:, agent, :2]).T), linewidth=0.6)
+    paths.set(title="true paths (solid) and believed (dashed)", xlabel="x", ylabel="y", aspect="equal")
+    paths.legend(fontsize="small")
+    gaps.set(title="belief off the truth", xlabel="t", ylabel="distance")
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
 def write_run_plots(result: RunResult, out_dir: Path) -> list[Path]:
-    """All three figures of a run into ``out_dir``; returns their paths."""
+    """The figures of a run into ``out_dir`` (and, with physics, belief against truth); returns their paths."""
     paths = [out_dir / "error.png", out_dir / "velocities.png", out_dir / "coverage_maps.png"]
     plot_domain_error(result, paths[0])
     plot_velocities(result, paths[1])
     plot_coverage_maps(result, paths[2])
+    if result.true_poses is not None and len(result.trace) == len(result.true_poses):
+        paths.append(out_dir / "truth.png")
+        plot_truth(result, paths[-1])
     return paths

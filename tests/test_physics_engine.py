@@ -63,6 +63,8 @@ def test_without_noise_the_truth_is_what_the_team_believes(physical):
 def test_with_noise_the_truth_is_kept_beside_the_belief_and_written_out(tmp_path):
     """The paper's law: it believes it covered everything; the cameras' true poses covered a little less
     (measured: 3 of 372 cells short, true coverage 99.2 %, completion 214.5 against 209.1 without noise)."""
+    from logger.recording import record_result
+    from logger.replay import summarise_recording
     from runtime.rundir import write_run_directory
 
     scenario = validate({**ROOMS, "physics": "mujoco", "noise": NOISE})
@@ -74,6 +76,10 @@ def test_with_noise_the_truth_is_kept_beside_the_belief_and_written_out(tmp_path
     assert result.physics["true_cells_short"] == round((1.0 - result.physics["true_coverage"]) * 372)
     summary = write_run_directory(result, tmp_path)
     assert summary["true_coverage"] == result.physics["true_coverage"]
+    assert (tmp_path / "truth.png").stat().st_size > 10_000  # belief against truth, drawn
+    record_result(result, tmp_path / "recording.rrd", recording_id="truth-test")
+    entities = summarise_recording(tmp_path / "recording.rrd", load_maps=False).entities
+    assert {f"/world/truth/{i}/position" for i in range(4)} | {f"/truth/{i}/error" for i in range(4)} <= entities
     lines = (tmp_path / "truth.csv").read_text().splitlines()
     assert lines[0] == "t,agent,x,y,theta,x_believed,y_believed,theta_believed"
     assert len(lines) == 1 + len(result.trace) * 4
