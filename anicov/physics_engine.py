@@ -15,6 +15,7 @@ complete, ``true_cells_short`` what it left.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 
 import numpy as np
@@ -80,6 +81,9 @@ def run_physics(
     """One team to full coverage or ``max_time``, its robots moved by the physics world; ``advance`` is the
     engine's step (:func:`anicov.engine.advance_team`, or a plug-in's), taken one step at a time."""
     controller = controller_of(scenario)
+    margin = noise_of(scenario).cover_margin
+    if margin:  # the team's own map asks (1 + margin) Λ* of every cell; the truth's map Λ* (model.physics.noise)
+        coverage_map = coverage_map_of(dataclasses.replace(scenario, lambda_star=scenario.lambda_star * (1 + margin)))
     law, world = controller.law(scenario, coverage_map.target_ticks), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     looks = np.full((scenario.agents, 2), np.nan)

@@ -61,8 +61,8 @@ def test_without_noise_the_truth_is_what_the_team_believes(physical):
 
 
 def test_with_noise_the_truth_is_kept_beside_the_belief_and_written_out(tmp_path):
-    """The paper's law: it believes it covered everything; the cameras' true poses covered a little less
-    (measured: 3 of 372 cells short, true coverage 99.2 %, completion 214.5 against 209.1 without noise)."""
+    """The paper's law: it believes it covered everything; the cameras' true poses may have covered a little
+    less (measured, seed 2: with the cover margin 0 of 372 cells short, without it 3, 99.2 %)."""
     from logger.recording import record_result
     from logger.replay import summarise_recording
     from runtime.rundir import write_run_directory
@@ -72,7 +72,7 @@ def test_with_noise_the_truth_is_kept_beside_the_belief_and_written_out(tmp_path
     assert result.completed and result.physics["physical_contacts"] == 0
     errors = np.hypot(*(result.true_poses[:, :, :2] - result.trace[:, :, :2]).transpose(2, 0, 1))
     assert 0.0 < errors.mean() < 0.2  # the belief is off the truth by about the localiser's σ
-    assert 0.9 <= result.physics["true_coverage"] <= 1.0
+    assert 0.995 <= result.physics["true_coverage"] <= 1.0  # the issue's goal, with the default cover margin
     assert result.physics["true_cells_short"] == round((1.0 - result.physics["true_coverage"]) * 372)
     summary = write_run_directory(result, tmp_path)
     assert summary["true_coverage"] == result.physics["true_coverage"]

@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from model.physics.noise import Belief, CommandDelay, Noise, in_own_frame, moved_by, noise_of
+from model.physics.noise import COVER_MARGIN, Belief, CommandDelay, Noise, in_own_frame, moved_by, noise_of
 from model.scenario import validate
 
 
@@ -76,4 +76,7 @@ def test_the_noise_table_in_whole_control_periods():
     noise = noise_of(scenario)
     assert (noise.localiser_period, noise.localiser_delay, noise.command_delay) == (1, 1, 2)
     assert math.isclose(noise.localiser_heading, math.radians(2.0)) and not noise.none
-    assert noise_of(validate({})).none
+    assert noise.cover_margin == COVER_MARGIN  # with noise the team over-covers its own map by default
+    assert noise_of(validate({})).none and noise_of(validate({})).cover_margin == 0.0
+    exact = validate({"robot_radius": 0.3, "physics": "mujoco", "noise": {"localiser_sigma": 0.05, "cover_margin": 0}})
+    assert noise_of(exact).cover_margin == 0.0

@@ -14,7 +14,8 @@
   wheel odometry gathers per unit travelled and per radian turned), ``localiser_sigma`` and
   ``localiser_heading_deg`` (σ of a localiser's fix), ``localiser_rate`` (fixes per time unit; 0: none),
   ``localiser_latency`` (time units from the pose a fix measures to its arrival), ``command_latency`` (time
-  units from a command to the wheels). Seeded by the scenario's seed.
+  units from a command to the wheels), ``cover_margin`` (the team covers its own map to (1 + this) Λ*: with
+  noise 0.1 by default, :data:`model.physics.noise.COVER_MARGIN`). Seeded by the scenario's seed.
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ NOISE_KEYS = (
     "localiser_rate",
     "localiser_latency",
     "command_latency",
+    "cover_margin",
 )
 
 
