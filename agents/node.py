@@ -159,6 +159,11 @@ class AgentNode:
             if delta.agent != self.options.agent:
                 self.replica.apply(delta)
 
+    def park(self, agents: set[int]) -> None:
+        """Realtime: teammates done for good (protocol.settling) stand as bodies, not as poses growing old."""
+        for agent in agents & set(range(len(self.kinds))) - {self.options.agent}:
+            self.kinds[agent] = PARKED
+
     def note_position(self, state: AgentState) -> None:
         """A teammate's pose at the end of its step (lockstep: every member's, at the start of this step).
         A step its robot held for want of a pose (POSE_STALE) repeats the last known one: it does not make
@@ -292,7 +297,7 @@ class AgentNode:
                 v,
                 omega,
                 me,
-                self.radio.beyond_reach(self.poses),
+                self.radio.beyond_reach(self.poses, self.kinds),
                 self.pose_ages(),
                 self.kinds,
                 self.ground,

@@ -44,7 +44,7 @@ from protocol.agreement import (
 from protocol.messages import AgentState, AgentStep, MapDelta, encode
 from protocol.recovery import END_ONLY, GAP_CHECK_PERIOD, History, LossTimer, fetch, fetch_snapshot, fill_gaps
 from protocol.session import RouterUnreachable, logger_listens, open_session, team_publisher, zenoh_config
-from protocol.settling import EndBarrier, settle
+from protocol.settling import STOPPED, EndBarrier, settle
 from protocol.sync import SYNC_PERIOD, SyncServer, sync_with
 from protocol.traffic import TrafficReporter
 from runtime.lifecycle import EXIT_FAILED, EXIT_OK, EXIT_USAGE, StopFlag, parent_is_gone, settle_garbage_collector
@@ -352,6 +352,8 @@ def run_realtime_steps(bus: Bus, period: float, stop: StopFlag, parent: int) -> 
                 fill_gaps(bus.session, node.keys, node.replica, node.inbox)  # teammates' deltas lost on the way
             fetch(bus.session, node.keys.go_history, node.inbox, first=END_ONLY)  # the end of the run, if lost
             next_gap_check = time.monotonic() + GAP_CHECK_PERIOD
+        if bus.barrier is not None:
+            node.park(bus.barrier.reached(STOPPED, "agent"))  # teammates done for good stand still
         behind = time.monotonic() - (started + (node.step - first_step) * period)
         if node.ends_on_its_own():
             break

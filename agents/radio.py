@@ -11,6 +11,7 @@ import numpy as np
 from model.controllers import controller_of
 from model.paper.coverage_map import CoverageMap
 from model.planning import watched_planner
+from model.safety.safety import TEAMMATE
 from model.scenario import Scenario
 from protocol.messages import AgentState, Pose
 from protocol.recovery import HISTORY_STEPS, RELAY_STEPS
@@ -61,16 +62,18 @@ class RadioLink:
             self.heard_live[state.agent] = time.monotonic()
         return True
 
-    def beyond_reach(self, poses: np.ndarray) -> np.ndarray:
+    def beyond_reach(self, poses: np.ndarray, kinds: np.ndarray) -> np.ndarray:
         """The teammates' poses for the safety filter, a teammate whose latest step came from beyond comm_range
         left out (NaN). Its last heard pose ages while it is away, and the filter stops a robot for a pose in
         reach older than max_pose_age: a teammate that walked out of range stopped the team for ever. Its
         steps still come, dropped by the range: it is farther than comm_range, which is at least safety_range
-        (the scenario check), the filter's reach."""
-        if not self.last_beyond.any():
+        (the scenario check), the filter's reach. A parked teammate (dead, or done: its base stands) is always
+        shown: it no longer sends steps that could say where it is."""
+        away = self.last_beyond & (kinds == TEAMMATE)
+        if not away.any():
             return poses
         seen = poses.copy()
-        seen[self.last_beyond] = np.nan
+        seen[away] = np.nan
         return seen
 
     def in_contact(self) -> list[int]:

@@ -86,7 +86,7 @@ def replay(
             node.log.record(state)
             node.positions[state.agent] = (state.pose[0], state.pose[1])
         if (node.lockstep or node.planner.replayed) and step % node.scenario.plan_steps == 0:
-            node.plan(step)
+            node.plan(step if node.lockstep else 0)  # realtime plans as the live ones did (coordinator.stepping)
         for state in states.get(step, []):
             node.latest_state_step[state.agent] = step
             node.positions[state.agent] = (state.next_pose[0], state.next_pose[1])

@@ -379,7 +379,7 @@ def record_result(result, path: Path, recording_id: str, map_every: int = 50) ->
         recorder.lack_map(round(time / result.scenario.dt), snapshot / 255.0)  # 8-bit snapshots
     recorder.lack_map(result.steps, result.final_lack)
     recorder.domain_errors(result.errors)
-    if result.true_poses is not None and len(result.true_poses) == len(trace):
+    if result.true_poses is not None and len(result.trace) == result.steps + 1 and len(result.true_poses) == len(trace):
         recorder.truth(result.true_poses, trace[:, :, :3])
     frame = map_frame_of(result.scenario)
     for stall in result.stalls:

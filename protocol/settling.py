@@ -101,6 +101,11 @@ class EndBarrier:
         with self._lock:
             return {m for m in self._alive if m[0] in wanted and m != self.me} - self._reached[phase]
 
+    def reached(self, phase: str, role: str) -> set[int]:
+        """The ids of the processes of ``role`` that have reached ``phase``."""
+        with self._lock:
+            return {ident for kind, ident in self._reached[phase] if kind == role}
+
     def wait(
         self,
         phase: str,

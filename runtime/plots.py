@@ -135,7 +135,11 @@ def write_run_plots(result: RunResult, out_dir: Path) -> list[Path]:
     plot_domain_error(result, paths[0])
     plot_velocities(result, paths[1])
     plot_coverage_maps(result, paths[2])
-    if result.true_poses is not None and len(result.trace) == len(result.true_poses):
+    if (
+        result.true_poses is not None
+        and len(result.trace) == result.steps + 1
+        and len(result.trace) == len(result.true_poses)
+    ):
         paths.append(out_dir / "truth.png")
         plot_truth(result, paths[-1])
     return paths

@@ -268,7 +268,11 @@ def write_run_directory(result: RunResult, out_dir: Path, counts: dict[str, obje
 
     out_dir.mkdir(parents=True, exist_ok=True)
     write_trajectory(result, out_dir / "trajectory.csv")
-    if result.true_poses is not None and len(result.trace) == len(result.true_poses):
+    if (
+        result.true_poses is not None
+        and len(result.trace) == result.steps + 1
+        and len(result.trace) == len(result.true_poses)
+    ):
         write_truth(result, out_dir / "truth.csv")
     summary = summary_of(result)
     write_summary(summary, out_dir / "summary.json")

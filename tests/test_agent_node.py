@@ -213,3 +213,14 @@ def test_a_teammates_hello_tells_where_its_robot_really_is():
     assert tuple(node.poses[2]) == (40.0, 60.0, 1.0) and tuple(node.positions[2]) == (40.0, 60.0)
     node.handle(Received("agent", AgentState(0, -1, (1.0, 1.0, 0.0), 0.0, 0.0, 0.0, (1.0, 1.0, 0.0))))
     assert tuple(node.poses[0]) != (1.0, 1.0, 0.0)  # our own echo is not a teammate
+
+
+def test_teammates_done_for_good_are_parked_for_the_filter_and_nothing_else_changes():
+    """Realtime: a teammate whose run is over (its 'stopped' token, protocol.settling) stands still; the filter
+    keeps it as a body instead of a pose growing old, which stopped a robot near it for up to the barrier's
+    limit. Ids outside the team, and our own, are ignored."""
+    from model.safety.safety import PARKED, TEAMMATE
+
+    node = node_for(agent=0, clock="realtime")
+    node.park({0, 2, 99})
+    assert node.kinds.tolist() == [TEAMMATE, TEAMMATE, PARKED, TEAMMATE]

@@ -14,7 +14,7 @@ from anicov.engine import run_scenario
 from model.controllers.anicov.lane_planner import LOOKAHEAD, LanePlanner, blob_passes
 from model.paper.control import pursuit_law
 from model.paper.geometry import wrap_angle
-from model.parameters import initial_poses
+from model.parameters import starting_poses
 from model.scenario import Scenario, ScenarioError, load_scenario
 
 PAPER = Scenario(stations=False)  # the spiral (tests/test_stations.py has the stations)
@@ -107,7 +107,7 @@ def test_every_robot_cuts_the_same_routes_at_its_first_local_plan_whoever_it_hea
     scenario = PAPER.with_overrides(
         domain=[40.0, 40.0], agents=3, controller="anicov", robot_radius=radius, stations=True
     )
-    start = initial_poses(scenario)[:, :2]
+    start = starting_poses(scenario)[:, :2]
     lack = np.ones(scenario.grid_shape)
     team = LanePlanner(scenario)
     team.plan(lack, start)

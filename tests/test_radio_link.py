@@ -5,8 +5,11 @@ import math
 import numpy as np
 
 from agents.radio import RadioLink
+from model.safety.safety import PARKED, TEAMMATE
 from model.scenario import Scenario
 from protocol.messages import AgentState
+
+TEAMMATES = np.array([TEAMMATE, TEAMMATE, TEAMMATE])
 
 
 def state_of(agent: int, x: float, y: float) -> AgentState:
@@ -23,14 +26,16 @@ def test_a_teammate_whose_latest_step_came_from_beyond_range_is_left_out_of_the_
     me = (10.0, 10.0, 0.0)
     poses = np.array([me, (12.0, 10.0, 0.0), (14.0, 10.0, 0.0)])
     assert radio.hears(state_of(1, 12.0, 10.0), me) and radio.hears(state_of(2, 14.0, 10.0), me)
-    assert np.array_equal(radio.beyond_reach(poses), poses)
+    assert np.array_equal(radio.beyond_reach(poses, TEAMMATES), poses)
     assert not radio.hears(state_of(2, 25.0, 10.0), me)  # 15 away: dropped, counted
     assert radio.out_of_range == 1
-    shown = radio.beyond_reach(poses)
+    shown = radio.beyond_reach(poses, TEAMMATES)
     assert np.isnan(shown[2]).all() and np.array_equal(shown[:2], poses[:2])
     assert np.array_equal(poses[2], (14.0, 10.0, 0.0))  # the node's own record is left as it was
+    parked = np.array([TEAMMATE, TEAMMATE, PARKED])  # it died, or its run is over: its base stands there
+    assert np.array_equal(radio.beyond_reach(poses, parked), poses)
     assert radio.hears(state_of(2, 15.0, 10.0), me)  # back in range
-    assert np.array_equal(radio.beyond_reach(poses), poses)
+    assert np.array_equal(radio.beyond_reach(poses, TEAMMATES), poses)
 
 
 def test_with_an_unlimited_radio_every_teammate_is_heard_and_shown():
@@ -38,4 +43,4 @@ def test_with_an_unlimited_radio_every_teammate_is_heard_and_shown():
     assert math.isinf(radio.scenario.comm_range)
     assert radio.hears(state_of(1, 1000.0, 1000.0), (0.0, 0.0, 0.0))
     poses = np.array([(0.0, 0.0, 0.0), (1000.0, 1000.0, 0.0)])
-    assert np.array_equal(radio.beyond_reach(poses), poses)
+    assert np.array_equal(radio.beyond_reach(poses, TEAMMATES[:2]), poses)

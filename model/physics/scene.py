@@ -29,6 +29,9 @@ SERVO_STEPS = 4.0
 CONTACT_STEPS = 2.0
 """Contacts' time constant, in physics steps (MuJoCo's stiffest stable): at its default, 0.02 s, a wheel sank
 so far into the floor that it rolled 4 % short of its radius."""
+WHEEL_BIT = 2
+"""The wheels' contact bit: they touch the floor only. A sphere wheel at ±b/2 reaches b/2 + r_w (1.07 r with the
+defaults) from the axis, past the body the filter keeps apart; robots and walls meet at the chassis."""
 GRAVITY = 9.81
 """In length units per time unit squared: metres and seconds on the real maps."""
 WALL_HEIGHT = 3.0
@@ -85,7 +88,7 @@ def scene_xml(domain: tuple[float, float], ground: Ground, base: Base, poses: np
   </default>
   <worldbody>
     <geom name="floor" type="plane" pos="{width / 2} {height / 2} 0" size="{floor} {floor} 0.1"
-          friction="{base.friction} 0.005 0.0001"/>
+          friction="{base.friction} 0.005 0.0001" conaffinity="{1 | WHEEL_BIT}"/>
 {geoms}
 {robots}
   </worldbody>
@@ -106,7 +109,7 @@ def _robot_xml(i: int, pose: np.ndarray, base: Base) -> str:
         f'      <body name="{side}{i}" pos="0 {sign * base.wheel_separation / 2} 0">\n'
         f'        <joint name="{side}{i}" type="hinge" axis="0 1 0"/>\n'
         f'        <geom name="{side}wheel{i}" type="sphere" size="{wheel}" '
-        f'mass="{0.1 * base.mass}" friction="{base.friction} 0.005 0.0001"/>\n'
+        f'mass="{0.1 * base.mass}" friction="{base.friction} 0.005 0.0001" contype="{WHEEL_BIT}" conaffinity="0"/>\n'
         "      </body>"
         for side, sign in (("left", 1.0), ("right", -1.0))
     )

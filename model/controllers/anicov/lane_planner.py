@@ -66,7 +66,7 @@ from model.controllers.anicov.terrain_lanes import terrain_routes
 from model.controllers.anicov.touch_ups import TouchUp, blob_labels, with_touch_ups
 from model.controllers.anicov.weave import sweep_of
 from model.paper.objectives import BlobObjectives
-from model.parameters import initial_poses
+from model.parameters import starting_poses
 from model.planning import TeamPlanner
 from model.scenario import Scenario
 
@@ -197,7 +197,7 @@ class LanePlanner(TeamPlanner):
     def _all(self, ids: list[int], positions: np.ndarray) -> np.ndarray:
         """Every robot's position at the first plan; a robot not among the members (planning = "local", out of
         radio contact) at its seeded start pose, so that every robot cuts the same routes for the team."""
-        where = initial_poses(self.scenario)[:, :2].copy()
+        where = starting_poses(self.scenario)[:, :2].copy()  # among walls: clear of them (free_initial_poses)
         for index, agent in enumerate(ids):
             where[agent] = positions[index]
         return where
