@@ -82,5 +82,4 @@ def test_with_noise_the_truth_is_kept_beside_the_belief_and_written_out(tmp_path
     assert {f"/world/truth/{i}/position" for i in range(4)} | {f"/truth/{i}/error" for i in range(4)} <= entities
     lines = (tmp_path / "truth.csv").read_text().splitlines()
     assert lines[0] == "t,agent,x,y,theta,x_believed,y_believed,theta_believed"
-    assert len(lines) == 1 + len(result.trace) * 4
-    assert run_scenario(scenario).trace.tobytes() == result.trace.tobytes()  # the noise is seeded
+    assert len(lines) == 1 + len(result.trace) * 4  # (that the noise repeats by its seed: test_physics_noise)

@@ -94,7 +94,7 @@ def test_realtime_local_planning_with_anicov_among_walls_on_a_limited_radio_comp
     config = write_scenario(tmp_path / "s.toml", **ROOMS, planning="local", comm_range=6.0)
     team, out = unique_team(), tmp_path / "team"
     command = launcher_command(
-        "--config", str(config), "--out", str(out), "--clock", "realtime", "--no-record", team=team
+        "--config", str(config), "--out", str(out), "--clock", "realtime", "--speed", "20", "--no-record", team=team
     )
     launched = run(command, timeout=400)
     assert launched.returncode == 0, launched.stderr + launched.stdout
