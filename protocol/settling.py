@@ -49,9 +49,15 @@ Member = tuple[str, int]
 def member_of_key(key: str, after: str) -> tuple[str, Member] | None:
     """The last three parts of ``…/<after>/<a>/<role>/<id>`` as (a, (role, id)); None if malformed."""
     parts = key.split("/")
-    if len(parts) < 4 or parts[-4] != after or not parts[-1].isdigit() or len(parts[-1]) > 6:
+    member = _member(parts) if len(parts) >= 4 and parts[-4] == after else None
+    return None if member is None else (parts[-3], member)
+
+
+def _member(parts: list[str]) -> Member | None:
+    """(role, id) from a key's last two parts; None unless the id is a number of at most 6 digits."""
+    if not parts[-1].isdigit() or len(parts[-1]) > 6:
         return None
-    return parts[-3], (parts[-2], int(parts[-1]))
+    return parts[-2], int(parts[-1])
 
 
 class EndBarrier:
@@ -169,6 +175,4 @@ def settle(
 def alive_member(key: str) -> Member | None:
     """(role, id) of ``…/alive/<role>/<id>``; None if malformed."""
     parts = key.split("/")
-    if len(parts) < 3 or parts[-3] != "alive" or not parts[-1].isdigit() or len(parts[-1]) > 6:
-        return None
-    return parts[-2], int(parts[-1])
+    return _member(parts) if len(parts) >= 3 and parts[-3] == "alive" else None
