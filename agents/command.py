@@ -14,7 +14,7 @@ from model.scenario import Scenario, ScenarioError
 from runtime.arguments import add_process_arguments, scenario_from_arguments
 
 if TYPE_CHECKING:
-    from agents.ros2.options import Ros2Options
+    from protocol.ros2.options import Ros2Options
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -76,5 +76,5 @@ def ros2_options(args: argparse.Namespace, scenario: Scenario) -> Ros2Options:
     from agents.ros2.arguments import check_real_time, ros2_options_from
 
     require_rosbags()
-    check_real_time(args.clock, args.speed, scenario.seconds_per_unit)
+    check_real_time(args.clock, args.speed, scenario.seconds_per_unit, args.ros_sim_time)
     return ros2_options_from(args)

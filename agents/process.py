@@ -52,7 +52,7 @@ from runtime.rundir import write_counts
 
 if TYPE_CHECKING:
     from agents.ros2.driver import Ros2Robot
-    from agents.ros2.options import Ros2Options
+    from protocol.ros2.options import Ros2Options
 
 log = logging.getLogger("anicov.agent")
 

@@ -17,6 +17,7 @@ from logger import command as logger_command
 from model.scenario import ScenarioError
 from runtime.arguments import add_scenario_arguments, note_map_fit, scenario_from_arguments
 from runtime.lifecycle import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, EXIT_USAGE
+from simulator import command as simulator_command
 
 
 def command_run(args: argparse.Namespace) -> int:
@@ -183,11 +184,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="anicov", description=__doc__)
     commands = parser.add_subparsers(dest="command", required=True)
     _add_in_process_commands(commands)
-    # The team's processes: each part declares its own arguments (agents/, coordinator/, logger/ command.py).
+    # The team's processes: each part declares its own arguments (agents/, coordinator/, logger/, simulator/ command.py).
     for name, part, text in (
         ("agent", agent_command, "one robot of a team, on the Zenoh bus"),
         ("coordinator", coordinator_command, "the team's coordinator (Algorithms 1-2), on the bus"),
         ("logger", logger_command, "record a team over the bus into a rerun recording"),
+        ("sim", simulator_command, "play every robot's ROS 2 base in a physics world, on the bus (--robot ros2)"),
     ):
         command = commands.add_parser(name, help=text)
         part.add_arguments(command)

@@ -22,7 +22,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from agents.command import add_deltas_argument
-from anicov.ros2_team import add_ros2_team_arguments, check_ros2_team, ros2_agent_flags, test_base_commands
+from anicov.ros2_team import (
+    add_ros2_team_arguments,
+    check_ros2_team,
+    merge_simulator_figures,
+    ros2_agent_flags,
+    test_base_commands,
+)
 from model.scenario import Scenario
 from runtime.arguments import add_team_arguments, note_map_fit, scenario_from_arguments
 from runtime.lifecycle import (
@@ -43,6 +49,8 @@ log = logging.getLogger("anicov.launch")
 
 GRACE_SECONDS = 10.0
 """How long children get to exit after SIGTERM before SIGKILL."""
+SIM_END_SECONDS = 5.0
+"""Seconds the launcher gives anicov sim to write its figures and leave by itself after the team; then SIGTERM."""
 LOGGER_NICE = 10
 """The logger's CPU priority below the team's: it is off the critical path and catches up when cores idle."""
 COORDINATOR_RESTARTS = 3
@@ -247,8 +255,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"launch_team: error: cannot open the router on {args.listen}: {error}", file=sys.stderr)
         return EXIT_USAGE
     children: list[Child] = []
-    # Stand-in ROS 2 bases (--test-bases): up before the agents wait for their poses, stopped after them.
-    bases = [spawn(f"base-{i}", command, logs) for i, command in enumerate(test_base_commands(args, scenario, logs))]
+    bases = start_bases(args, scenario, out_dir)
     with router:
         keys, watch = TeamKeys(args.team), ControlWatch(scenario)
         router.declare_subscriber(keys.control, watch.on_sample)
@@ -270,11 +277,31 @@ def main(argv: list[str] | None = None) -> int:
                 if not args.no_coordinator:
                     note_failed_agents(children, seen, watch)
             stop_children(children)
-            stop_children(bases)
+            stop_bases(bases, args.sim_bases and not stop.stopped, out_dir)
     if stop.stopped:
         print(f"launch_team: stopped by signal; every child stopped. Logs in {logs}", file=sys.stderr)
         return stop.exit_code(EXIT_FAILED)
     return report(args, scenario.agents, out_dir, children, seen, time.monotonic() - started, scenario.dt)
+
+
+def start_bases(args: argparse.Namespace, scenario: Scenario, out_dir: Path) -> list[Child]:
+    """Stand-in ROS 2 bases (--test-bases) or the simulator playing them all (--sim-bases, anicov.ros2_team):
+    up before the agents wait for their poses, stopped after them."""
+    logs = out_dir / "logs"
+    bases = [spawn(f"base-{i}", command, logs) for i, command in enumerate(test_base_commands(args, scenario, logs))]
+    if args.sim_bases:
+        bases.append(spawn("sim", child_command("sim", args, ["--out", str(out_dir)]), logs))
+    return bases
+
+
+def stop_bases(bases: list[Child], simulated: bool, out_dir: Path) -> None:
+    """Stop the bases after the team; a simulator first gets SIM_END_SECONDS to leave by itself (it does once
+    every agent has), then its figures join summary.json."""
+    if simulated:
+        wait_for_exit(bases, SIM_END_SECONDS)
+    stop_children(bases)
+    if simulated:
+        merge_simulator_figures(out_dir)
 
 
 def apply_secure_profile(args: argparse.Namespace, agents: int) -> str | None:
@@ -465,6 +492,7 @@ def report(
             f"  processes       coordinator + {agents} agents"
             + ("" if args.no_record else " + logger")
             + (f" + {agents} stand-in ROS 2 bases" if args.test_bases else "")
+            + (" + anicov sim (the bases in the physics world)" if args.sim_bases else "")
             + f", logs in {logs}"
         )
         if seen.lost:

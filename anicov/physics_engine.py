@@ -15,7 +15,6 @@ complete, ``true_cells_short`` what it left.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 
 import numpy as np
@@ -23,51 +22,14 @@ import numpy as np
 from anicov.run_parts import Snapshots, finish_run, objective_fields
 from model.controllers import controller_of
 from model.paper.coverage_map import CoverageMap
-from model.parameters import coverage_map_of, safety_parameters
-from model.physics.base import base_of
-from model.physics.noise import Belief, CommandDelay, noise_of
-from model.physics.world import PhysicsWorld
+from model.parameters import safety_parameters
+from model.physics.noise import Belief, noise_of
+from model.physics.team import PhysicalTeam
 from model.planning import watched_planner
 from model.run import TRACE_FIELDS, ProgressCallback, RunResult
 from model.safety.safety import MEMORY_SIZE
 from model.scenario import Scenario
-from model.step import LawParameters, sense_only
-from model.world.ground import Ground
 from model.world.world import world_of
-
-
-class PhysicalTeam:
-    """The world, what the robots believe of their poses, their late commands, and the truth's own map."""
-
-    def __init__(self, scenario: Scenario, poses: np.ndarray, ground: Ground) -> None:
-        noise = noise_of(scenario)
-        self.world = PhysicsWorld(scenario.domain, ground, base_of(scenario), poses, scenario.dt)
-        self.truth = self.world.poses()
-        self.belief = Belief(noise, self.truth, scenario.seed)
-        self.delay = CommandDelay(noise.command_delay, scenario.agents)
-        self.true_map = coverage_map_of(scenario)
-        self.true_poses = [self.truth.copy()]
-
-    def move(self, commands: np.ndarray, law: LawParameters, ground: Ground) -> np.ndarray:
-        """The cameras sense from the true poses of t_k, the wheels take the commands due, the world steps;
-        the believed poses of t_{k+1}."""
-        positions = self.truth[:, :2].copy()
-        for i, (x, y, theta) in enumerate(self.truth):
-            self.true_map.add(*sense_only(self.true_map.coverage, x, y, theta, law, ground, positions, i))
-        self.truth = self.world.step(self.delay(commands))
-        self.true_poses.append(self.truth.copy())
-        return self.belief.update(self.truth)
-
-    def figures(self) -> dict[str, float | int]:
-        """What summary.json reports of the physics and the truth."""
-        contacts, true_map = self.world.contacts, self.true_map
-        return {
-            "physical_contacts": contacts.total,
-            "robot_contacts": contacts.robots,
-            "wall_contacts": contacts.walls,
-            "true_coverage": 1.0 - true_map.uncovered_cells / true_map.counted_cells,
-            "true_cells_short": int(true_map.uncovered_cells),
-        }
 
 
 def run_physics(
@@ -81,15 +43,13 @@ def run_physics(
     """One team to full coverage or ``max_time``, its robots moved by the physics world; ``advance`` is the
     engine's step (:func:`anicov.engine.advance_team`, or a plug-in's), taken one step at a time."""
     controller = controller_of(scenario)
-    margin = noise_of(scenario).cover_margin
-    if margin:  # the team's own map asks (1 + margin) Λ* of every cell; the truth's map Λ* (model.physics.noise)
-        coverage_map = coverage_map_of(dataclasses.replace(scenario, lambda_star=scenario.lambda_star * (1 + margin)))
     law, world = controller.law(scenario, coverage_map.target_ticks), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     looks = np.full((scenario.agents, 2), np.nan)
     planner, block = watched_planner(scenario, controller.planner(scenario)), controller.plan_steps(scenario)
     team = PhysicalTeam(scenario, poses, world.ground)
     poses[:] = team.truth  # the start poses as the world holds them (read back through its quaternions)
+    belief = Belief(noise_of(scenario), team.truth, scenario.seed)
     agents = scenario.agents
     trace, errors_now = np.zeros((1, agents, len(TRACE_FIELDS))), np.zeros(1)
     flags_now = np.zeros((1, agents), dtype=np.uint8)
@@ -111,7 +71,7 @@ def run_physics(
             coverage_map.uncovered_cells, coverage_map.deficit_ticks,
             coverage_map.target_ticks * coverage_map.counted_cells, trace, errors_now, flags_now,
         )  # fmt: skip
-        poses[:] = team.move(trace[0, :, 3:5], law, world.ground)  # believed, from the world's: not eq. 1's
+        poses[:] = belief.update(team.move(trace[0, :, 3:5], law, world.ground))  # believed, from the world's
         rows.append(trace.copy() if record_trace else np.abs(trace[:, :, 3]).reshape(1, agents, 1))
         flags.append(flags_now.copy())
         errors.append(errors_now.copy())

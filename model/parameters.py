@@ -13,6 +13,7 @@ from model.paper.coverage_map import CoverageMap
 from model.radio.exact_coverage import ExactKernel, exact_kernel
 from model.safety.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
+from model.scenario.physics_keys import cover_margin_of
 from model.scenario.safety_keys import point_speed
 from model.world.clearance import disk_is_free
 from model.world.world import map_frame_of, world_of
@@ -29,14 +30,17 @@ def exact_kernel_of(scenario: Scenario) -> ExactKernel | None:
         return None
 
 
-def coverage_map_of(scenario: Scenario) -> CoverageMap:
+def coverage_map_of(scenario: Scenario, with_margin: bool = True) -> CoverageMap:
     """A fresh map of the scenario's grid, started as its world says (:meth:`model.world.world.World.head_start`:
-    cells nobody can cover are out of e_D; a priority map's cells start part-way)."""
+    cells nobody can cover are out of e_D; a priority map's cells start part-way). With noise
+    (:func:`model.scenario.physics_keys.cover_margin_of`) the team's map asks (1 + ``cover_margin``) Λ* of every cell, whichever process
+    keeps it; ``with_margin=False``: Λ*, the truth's map."""
     rows, cols = scenario.grid_shape
-    coverage_map = CoverageMap(rows, cols, scenario.cell, scenario.lambda_star)
+    margin = cover_margin_of(scenario) if with_margin else 0.0
+    coverage_map = CoverageMap(rows, cols, scenario.cell, scenario.lambda_star * (1.0 + margin))
     world = world_of(scenario)
     if not world.open or scenario.priority_map:
-        coverage_map.start_from(world.head_start(coverage_map.target_ticks))
+        coverage_map.start_from(world.head_start(coverage_map.target_ticks, 1.0 + margin))
     return coverage_map
 
 

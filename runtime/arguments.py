@@ -89,10 +89,12 @@ def scenario_from_arguments(args: argparse.Namespace) -> Scenario:
             f"scenario key 'controller': '{scenario.controller}' flies paths planned once for the team and runs "
             "in process only (anicov run, anicov sweep)"
         )
-    if hasattr(args, "clock") and scenario.physics != "kinematic":  # a team command, its clock settled or not
+    if hasattr(args, "clock") and scenario.physics != "kinematic" and getattr(args, "robot", "ros2") != "ros2":
+        # A team command whose agents would move their robots by eq. 1 (the coordinator and the logger move none).
         raise ScenarioError(
-            f"scenario key 'physics': '{scenario.physics}' runs in process only so far (anicov run, anicov sweep); a "
-            "team over Zenoh moves its robots by eq. 1 or drives ROS 2 bases (--robot ros2)"
+            f"scenario key 'physics': '{scenario.physics}': a team over Zenoh moves simulated robots by eq. 1; with "
+            "physics its agents drive ROS 2 bases that the simulator plays: launch_team.py --robot ros2 --sim-bases "
+            "(or anicov run in process)"
         )
     if getattr(args, "no_coordinator", False):
         check_no_coordinator(scenario, getattr(args, "clock", None))

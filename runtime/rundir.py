@@ -180,6 +180,11 @@ def format_summary(summary: dict[str, Any], out_dir: Path | None = None) -> str:
         )
     if "min_separation" in summary:
         lines.append(_safety_line(summary))
+    if "physical_contacts" in summary:
+        lines.append(
+            f"  physics         {summary['physical_contacts']} new contacts in the physics world; true coverage "
+            f"{100 * summary['true_coverage']:.2f} % ({summary['true_cells_short']} cells short at Λ*)"
+        )
     if out_dir is not None:
         lines.append(f"  outputs         {out_dir}/")
     return "\n".join(lines)

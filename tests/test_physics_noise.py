@@ -8,8 +8,9 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from model.physics.noise import COVER_MARGIN, Belief, CommandDelay, Noise, in_own_frame, moved_by, noise_of
+from model.physics.noise import Belief, CommandDelay, Noise, in_own_frame, moved_by, noise_of
 from model.scenario import validate
+from model.scenario.physics_keys import COVER_MARGIN
 
 
 def true_path(periods: int = 200) -> list[np.ndarray]:

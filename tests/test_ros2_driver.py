@@ -17,8 +17,8 @@ import zenoh.ext
 from rosbags.typesys import Stores, get_typestore
 
 from agents.ros2.driver import Ros2Robot
-from agents.ros2.options import Ros2Options
 from model.scenario import Scenario
+from protocol.ros2.options import Ros2Options
 from protocol.session import zenoh_config
 from tests.teamrun import free_port, limit
 

@@ -1,4 +1,4 @@
-"""agents.ros2.frames: quaternions, map ← odom, scenario units."""
+"""protocol.ros2.frames: quaternions, map ← odom, scenario units."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from agents.ros2.frames import ScenarioFrame, compose, invert, scale_into, yaw_of_quaternion
+from protocol.ros2.frames import ScenarioFrame, compose, invert, scale_into, yaw_of_quaternion
 
 angles = st.floats(-math.pi + 1e-6, math.pi, allow_nan=False)
 coordinates = st.floats(-1e3, 1e3, allow_nan=False)

@@ -1,4 +1,4 @@
-"""agents.ros2.messages: what the driver writes is what rosbags reads, and what it reads is checked."""
+"""protocol.ros2.messages: what the driver writes is what rosbags reads, and what it reads is checked."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from rosbags.typesys import Stores, get_typestore
 
-from agents.ros2.messages import BadRosMessage, dds_type_name, decode_pose, encode_velocity, type_hash
-from agents.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, TWIST, TWIST_STAMPED
+from protocol.ros2.messages import BadRosMessage, dds_type_name, decode_pose, encode_velocity, type_hash
+from protocol.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, TWIST, TWIST_STAMPED
 
 STORE = get_typestore(Stores.ROS2_JAZZY)
 T = STORE.types

@@ -1,4 +1,4 @@
-"""agents.ros2.transport: the Zenoh keys of a ROS 2 topic on both routes, and rmw_zenoh's attachment."""
+"""protocol.ros2.transport: the Zenoh keys of a ROS 2 topic on both routes, and rmw_zenoh's attachment."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import pytest
 import zenoh
 import zenoh.ext
 
-from agents.ros2.options import Ros2Options
-from agents.ros2.transport import Ros2Topics, bridge_key, rmw_zenoh_attachment, topic_name
+from protocol.ros2.options import Ros2Options
+from protocol.ros2.transport import Ros2Topics, bridge_key, rmw_zenoh_attachment, topic_name
 
 TWIST_KEY_TAIL = (
     "geometry_msgs::msg::dds_::Twist_/RIHS01_9c45bf16fe0983d80e3cfe750d6835843d265a9a6c46bd2e609fcddde6fb8d2a"

@@ -9,7 +9,7 @@ import re
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from agents.ros2.options import Ros2Options
+    from protocol.ros2.options import Ros2Options
 
 ROBOTS = ("sim", "ros2")
 NAME_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -63,12 +63,23 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
     )
     ros.add_argument("--ros-max-linear", type=float, help="the base's speed limit, m/s")
     ros.add_argument("--ros-max-angular", type=float, help="the base's turn-rate limit, rad/s")
+    _add_route_arguments(ros)
+
+
+def _add_route_arguments(ros: argparse._ArgumentGroup) -> None:
+    """Where the base is reached, and on whose clock."""
     ros.add_argument("--ros-domain", type=int, default=0, help="ROS_DOMAIN_ID (rmw-zenoh keys; default 0)")
     ros.add_argument(
         "--ros-distro",
         choices=("humble", "jazzy", "kilted"),
         default="jazzy",
         help="ROS 2 distribution of the message definitions and type hashes (default jazzy)",
+    )
+    ros.add_argument(
+        "--ros-sim-time",
+        action="store_true",
+        help="the base is anicov sim's, on the team's clock (ROS's use_sim_time): in lockstep each step acts on "
+        "the odometry of the next simulated instant, published once every robot's command is in; realtime at any --speed",
     )
     ros.add_argument(
         "--ros-connect",
@@ -87,11 +98,15 @@ def real_time_speed(seconds_per_unit: float) -> float:
     return 1.0 / seconds_per_unit
 
 
-def check_real_time(clock: str, speed: float, seconds_per_unit: float) -> None:
-    """A real base moves in real time: the realtime clock at :func:`real_time_speed`, else the flag."""
+def check_real_time(clock: str, speed: float, seconds_per_unit: float, sim_time: bool = False) -> None:
+    """A real base moves in real time: the realtime clock at :func:`real_time_speed`, else the flag. A simulated
+    one (``anicov sim``, ``sim_time``) runs on the team's clock, either clock at any speed."""
+    if sim_time:
+        return
     if clock != "realtime":
         raise RobotArgumentError(
-            "--robot ros2 drives a real base, which cannot wait for a lockstep go: use --clock realtime"
+            "--robot ros2 drives a real base, which cannot wait for a lockstep go: use --clock realtime (or, against "
+            "anicov sim's bases, --ros-sim-time)"
         )
     expected = real_time_speed(seconds_per_unit)
     if not math.isclose(speed, expected, rel_tol=1e-9):
@@ -117,7 +132,7 @@ def check_name(flag: str, name: str, namespace: bool = False) -> None:
 
 
 def ros2_options_from(args: argparse.Namespace) -> Ros2Options:
-    from agents.ros2.options import Ros2Options
+    from protocol.ros2.options import Ros2Options
 
     for flag, value in (
         ("--ros-pose-timeout", args.ros_pose_timeout),
@@ -162,4 +177,6 @@ def ros2_options_from(args: argparse.Namespace) -> Ros2Options:
         distribution=args.ros_distro,
         connect=tuple(args.ros_connect or ()),
         origin=(args.ros_origin[0], args.ros_origin[1]) if args.ros_origin else None,
+        sim_time=args.ros_sim_time,
+        lockstep=getattr(args, "clock", "realtime") == "lockstep",
     )

@@ -17,6 +17,10 @@ would never hear from it. What the driver does for a real base's sake:
   sent zero and the agent holds its step and says so, until odometry that arrived after that moment;
 - a watchdog thread sends zero when the control loop has sent nothing for ``WATCHDOG_PERIODS`` control
   periods (a blocking recovery query, a pause): the base does not roll on the last command meanwhile;
+- against ``anicov sim`` in lockstep (``sim_time``, ROS's use_sim_time) a step acts on the odometry of the
+  simulated instant after the one it acted on last (the simulator steps once every robot's command is in), not on
+  the freshest by the wall clock; no watchdog and no stop: the simulated base moves only when the world steps;
+- a localiser's fix stamped later than the newest odometry waits for the odometry of its instant;
 - :meth:`stop` sends zero (reliably, at once); the agent process calls it when its loop ends for any
   reason (end of run, Ctrl-C, SIGTERM, SIGHUP, an exception) before the sessions close. A lost router
   cannot carry that zero: the base's own command timeout must stop it then (deploy/ros2.md's checklist),
@@ -34,13 +38,12 @@ from collections.abc import Callable
 
 import zenoh
 
-from agents.ros2.frames import Pose, ScenarioFrame, compose, invert, scale_into
-from agents.ros2.messages import BadRosMessage, RosPose, decode_pose, encode_velocity
-from agents.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, Ros2Options
-from agents.ros2.transport import Ros2Topics
 from model.paper.dynamics import unicycle_step
 from model.scenario import Scenario
-from model.world.world import map_frame_of
+from protocol.ros2.frames import Pose, compose, frame_of, invert, scale_into
+from protocol.ros2.messages import BadRosMessage, RosPose, decode_pose, encode_velocity
+from protocol.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, Ros2Options
+from protocol.ros2.transport import Ros2Topics
 
 log = logging.getLogger("anicov.ros2")
 
@@ -48,19 +51,11 @@ WAIT_LOG_PERIOD = 2.0
 """Seconds between the 'waiting for a pose' lines while the agent waits for its robot."""
 WATCHDOG_PERIODS = 3
 """Control periods without a command after which the watchdog sends zero."""
+SIM_WAIT_LIMIT = 60.0
+"""Lockstep against anicov sim: wall seconds a step waits for the next simulated instant before it holds (the
+simulator steps as soon as every robot's command is in: only a simulator that died makes it wait this long)."""
 ODOMETRY_HISTORY = 256
 """Odometry poses kept to pair a localiser's pose with the odometry of the same instant (8 s at 30 Hz)."""
-
-
-def frame_of(scenario: Scenario, options: Ros2Options) -> ScenarioFrame:
-    """The scenario in the robot's map frame: its (0, 0) at ``origin`` if given (its axes the map frame's: a
-    given origin places the scenario unturned, whatever its map's yaw), else where the scenario's map puts it,
-    turned by the map's yaw (the same Nav2 map: the frames then agree; :func:`model.world.world.map_frame_of`,
-    the map's origin when no unknown border was cropped), else at the map frame's (0, 0); its units."""
-    if options.origin is not None:
-        return ScenarioFrame(options.origin, scenario.metres_per_unit, scenario.seconds_per_unit)
-    frame = map_frame_of(scenario)
-    return ScenarioFrame(frame.corner, scenario.metres_per_unit, scenario.seconds_per_unit, frame.yaw)
 
 
 class Ros2Robot:
@@ -68,7 +63,7 @@ class Ros2Robot:
 
     def __init__(self, session: zenoh.Session, options: Ros2Options, scenario: Scenario, agent: int) -> None:
         self.options, self.agent = options, agent
-        self.frame = frame_of(scenario, options)
+        self.frame = frame_of(scenario, options.origin)
         self._bounds = (scenario.k_v, math.pi * scenario.k_omega)  # eq. 15–16, scenario units
         self._dt = scenario.dt
         self._period = scenario.dt * scenario.seconds_per_unit  # wall seconds of one control step
@@ -77,10 +72,12 @@ class Ros2Robot:
         self._publisher = session.declare_publisher(
             self.topics.command_key, priority=zenoh.Priority.REAL_TIME, express=True
         )
-        self._lock = threading.Lock()  # the callbacks' state below
+        self._lock = threading.Condition()  # the callbacks' state below; notified on every odometry
         self._odometry: Pose | None = None  # odom frame, metres
         self._received_at = -math.inf  # monotonic seconds of the latest odometry
         self._history: deque[tuple[int, Pose]] = deque(maxlen=ODOMETRY_HISTORY)  # (stamp ns, odom pose)
+        self._early_fix: RosPose | None = None  # a localiser's fix stamped after the newest odometry
+        self._acted_stamp: int | None = None  # sim_time: the stamp of the odometry the last step acted on
         self._offset: Pose | None = None if options.localiser_topic else options.odom_offset  # map ← odom
         self._stale_since: float | None = None  # control thread only: the odometry went stale then
         self._acting: Pose | None = None  # control thread only: the pose this step acts on (None: hold)
@@ -95,7 +92,9 @@ class Ros2Robot:
             self._subscribers.append(session.declare_subscriber(self.topics.localiser_key, self._on_localiser))
         self._closing = threading.Event()
         self._watchdog = threading.Thread(target=self._watch, name=f"ros2-watchdog-{agent}", daemon=True)
-        self._watchdog.start()
+        self._stepped_by_simulator = options.sim_time and options.lockstep
+        if not self._stepped_by_simulator:
+            self._watchdog.start()
 
     # ------------------------------------------------------------ messages in (Zenoh's threads)
 
@@ -121,6 +120,10 @@ class Ros2Robot:
             self._received_at = time.monotonic()
             self._history.append((read.stamp_ns, read.pose))
             self.counters["poses_received"] += 1
+            if self._early_fix is not None and self._early_fix.stamp_ns <= read.stamp_ns:
+                self._correct(self._early_fix)
+                self._early_fix = None
+            self._lock.notify_all()
 
     def _on_localiser(self, sample: zenoh.Sample) -> None:
         """A map-frame pose: map ← odom = pose ⊕ (odometry of the same instant)⁻¹."""
@@ -128,11 +131,16 @@ class Ros2Robot:
         if read is None:
             return
         with self._lock:
-            if not self._history:
-                return  # no odometry yet to pair it with
-            _, odometry = min(self._history, key=lambda entry: abs(entry[0] - read.stamp_ns))
-            self._offset = compose(read.pose, invert(odometry))
-            self.counters["localiser_poses"] += 1
+            if not self._history or read.stamp_ns > self._history[-1][0]:
+                self._early_fix = read  # its instant's odometry is still on its way
+                return
+            self._correct(read)
+
+    def _correct(self, fix: RosPose) -> None:
+        """map ← odom from a fix and the odometry nearest its stamp (under the lock)."""
+        _, odometry = min(self._history, key=lambda entry: abs(entry[0] - fix.stamp_ns))
+        self._offset = compose(fix.pose, invert(odometry))
+        self.counters["localiser_poses"] += 1
 
     # ------------------------------------------------------------ pose (the control thread)
 
@@ -140,9 +148,12 @@ class Ros2Robot:
         """The latest map-frame pose (None until odometry and the map ← odom transform are both known)
         and when its odometry arrived, read together."""
         with self._lock:
-            if self._odometry is None or self._offset is None:
-                return None, -math.inf
-            return compose(self._offset, self._odometry), self._received_at
+            return self._snapshot_locked()
+
+    def _snapshot_locked(self) -> tuple[Pose | None, float]:
+        if self._odometry is None or self._offset is None:
+            return None, -math.inf
+        return compose(self._offset, self._odometry), self._received_at
 
     def pose(self) -> Pose:
         """The latest pose, fresh or not (hellos, held steps)."""
@@ -156,7 +167,10 @@ class Ros2Robot:
 
     def current_pose(self) -> Pose | None:
         """The pose this step acts on, or None while the odometry is stale: older than ``pose_timeout``,
-        or, after a stale spell, not newer than its start. Says when the robot stops and moves again."""
+        or, after a stale spell, not newer than its start. Says when the robot stops and moves again. Against
+        anicov sim in lockstep: the next simulated instant's (:meth:`_next_simulated_pose`)."""
+        if self._stepped_by_simulator:
+            return self._next_simulated_pose()
         map_pose, received = self._snapshot()
         now = time.monotonic()
         fresh = map_pose is not None and now - received <= self.options.pose_timeout
@@ -177,6 +191,29 @@ class Ros2Robot:
             )  # fmt: skip
         self._acting = self.frame.to_scenario(map_pose) if fresh and map_pose is not None else None
         return self._acting
+
+    def _next_simulated_pose(self) -> Pose | None:
+        """Lockstep against anicov sim: the pose of the simulated instant after the one the last step acted on
+        (None, a held step, if the simulator did not step within SIM_WAIT_LIMIT seconds)."""
+        deadline = time.monotonic() + SIM_WAIT_LIMIT
+        with self._lock:
+            while not self._closing.is_set():
+                stamp = self._history[-1][0] if self._history else None
+                ready = stamp is not None and self._offset is not None
+                if ready and (self._acted_stamp is None or stamp > self._acted_stamp):
+                    self._acted_stamp = stamp
+                    map_pose, _ = self._snapshot_locked()
+                    self._acting = self.frame.to_scenario(map_pose) if map_pose is not None else None
+                    return self._acting
+                if not self._lock.wait(timeout=max(0.0, min(0.5, deadline - time.monotonic()))):
+                    if time.monotonic() >= deadline:
+                        break
+        self.counters["stale_spells"] += 1
+        log.warning(
+            "agent %d: the simulator gave no next instant in %.0f s: this step holds", self.agent, SIM_WAIT_LIMIT
+        )
+        self._acting = None
+        return None
 
     def wait_for_pose(self, stopped: Callable[[], bool], give_up: Callable[[], bool]) -> bool:
         """Block until a first pose can be formed, saying where it waits; False if ``stopped()`` or
@@ -214,7 +251,11 @@ class Ros2Robot:
         return unicycle_step(*(acting or self.pose()), *self.last_command, self._dt)
 
     def stop(self) -> None:
-        """Zero velocity, now, and not dropped on a congested link."""
+        """Zero velocity, now, and not dropped on a congested link (a base the simulator steps in lockstep moves
+        only on a step's command: nothing to stop, and a zero would count as the next step's)."""
+        if self._stepped_by_simulator:
+            self.last_command = (0.0, 0.0)
+            return
         self._send(0.0, 0.0, reliably=True)
         self.last_command = (0.0, 0.0)
 
@@ -260,7 +301,8 @@ class Ros2Robot:
         try:
             self.stop()
         finally:
-            self._watchdog.join(timeout=1.0)
+            if self._watchdog.is_alive():
+                self._watchdog.join(timeout=1.0)
             for subscriber in self._subscribers:
                 subscriber.undeclare()
             self._publisher.undeclare()

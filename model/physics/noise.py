@@ -12,7 +12,7 @@ noisy fixes, and commands that reach the wheels late.
 - **Covering what is believed is not covering what is true**: a camera a little off its believed pose puts a
   cell's coverage partly on its neighbours, and a team that believes every cell has Λ* leaves some short in
   truth. So with noise the team covers its own map to (1 + ``cover_margin``) Λ*, by default
-  :data:`COVER_MARGIN`, and the run is judged against Λ* by the true poses (``true_coverage``).
+  :data:`model.scenario.physics_keys.COVER_MARGIN`, and the run is judged against Λ* by the true poses (``true_coverage``).
 
 Every draw comes from one generator seeded by the scenario's seed, in a fixed order: a run repeats exactly.
 """
@@ -26,12 +26,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from model.scenario import Scenario
+from model.scenario.physics_keys import cover_margin_of
 
-COVER_MARGIN = 0.1
-"""The default ``cover_margin`` with noise. Two rooms and a door, N = 4, the issue's noise (σ 0.05 on cells of
-1, 2°, 10 Hz, 0.1 late), seeds 0-9: without it 6 of 10 runs ended short in truth for either controller (at most
-3 cells of 372: 99.2 %); with 0.1 the paper's law 2 of 10 (1 cell each, 99.7 %) and anicov none, for 10 % and
-8 % more time (214.6 -> 236.0, 191.0 -> 205.8); with 0.25 the paper's law still 1 of 10 (2 cells), +19 %."""
 NOISE_SEED_SALT = 37
 """Mixed into the scenario's seed, so that the noise does not repeat the start poses' draw."""
 
@@ -57,7 +53,6 @@ def noise_of(scenario: Scenario) -> Noise:
     """The scenario's ``[noise]`` table, its times in whole control periods."""
     given = dict(scenario.noise)
     rate = given.get("localiser_rate", 0.0)
-    noisy = any(value > 0.0 for key, value in given.items() if key != "cover_margin")
     return Noise(
         odometry_per_metre=given.get("odometry_per_metre", 0.0),
         odometry_per_radian=given.get("odometry_per_radian", 0.0),
@@ -66,7 +61,7 @@ def noise_of(scenario: Scenario) -> Noise:
         localiser_period=max(1, round(1.0 / (rate * scenario.dt))) if rate > 0.0 else 0,
         localiser_delay=round(given.get("localiser_latency", 0.0) / scenario.dt),
         command_delay=round(given.get("command_latency", 0.0) / scenario.dt),
-        cover_margin=given.get("cover_margin", COVER_MARGIN if noisy else 0.0),
+        cover_margin=cover_margin_of(scenario),
     )
 
 
@@ -87,39 +82,37 @@ def moved_by(poses: np.ndarray, motion: np.ndarray) -> np.ndarray:
     return np.stack([x, y, np.angle(np.exp(1j * (poses[:, 2] + motion[:, 2])))], axis=1)
 
 
-class Belief:
-    """Every robot's believed pose, kept from the true poses the world gives each period (see the module)."""
+class Sensors:
+    """What every robot's sensors give, period by period, from the true poses the world gives: wheel odometry
+    (its motion in the robot's frame, with drift) and the localiser's fixes, each arriving
+    ``localiser_delay`` periods after the pose it measured (see the module). The in-process belief
+    (:class:`Belief`) and the simulator's ROS 2 bases (simulator/) read the same draws."""
 
     def __init__(self, noise: Noise, truth: np.ndarray, seed: int) -> None:
         self.noise = noise
         self.rng = np.random.default_rng([seed, NOISE_SEED_SALT])
-        self.poses = truth.copy()  # the start pose is known
         self.truth = truth.copy()
         self.step = 0
-        keep = noise.localiser_delay + 1
-        self.odometry: deque[np.ndarray] = deque(maxlen=keep)  # the last periods' odometry motions
-        self.measured: deque[tuple[int, np.ndarray]] = deque()  # fixes taken, waiting for their arrival
+        self.measured: deque[tuple[int, int, np.ndarray]] = deque()  # (arrival, measured at, fix) in flight
 
-    def update(self, truth: np.ndarray) -> np.ndarray:
-        """The world's true poses after one more period; the beliefs (N, 3) then."""
+    def update(self, truth: np.ndarray) -> tuple[np.ndarray, list[tuple[int, np.ndarray]]]:
+        """The world's true poses after one more period: the odometry's motion (N, 3) over it, and the
+        fixes that arrive now, each with the step whose pose it measured."""
         motion = in_own_frame(self.truth, truth)
         self.truth, self.step = truth.copy(), self.step + 1
-        if self.noise.none:
-            self.poses = truth.copy()
-            return self.poses
         odometry = motion + self._drift(motion)
-        self.odometry.append(odometry)
-        self.poses = moved_by(self.poses, odometry)
         noise = self.noise
         if noise.localiser_period and self.step % noise.localiser_period == 0:
             fix = truth + self.rng.normal(0.0, 1.0, truth.shape) * [
                 noise.localiser_sigma, noise.localiser_sigma, noise.localiser_heading
             ]  # fmt: skip
-            self.measured.append((self.step + noise.localiser_delay, fix))
+            fix[:, 2] = np.angle(np.exp(1j * fix[:, 2]))
+            self.measured.append((self.step + noise.localiser_delay, self.step, fix))
+        arrived = []
         while self.measured and self.measured[0][0] <= self.step:
-            _, fix = self.measured.popleft()
-            self.poses = self._replayed(fix)
-        return self.poses
+            _, measured_at, fix = self.measured.popleft()
+            arrived.append((measured_at, fix))
+        return odometry, arrived
 
     def _drift(self, motion: np.ndarray) -> np.ndarray:
         travelled = np.abs(motion[:, :2]).sum(axis=1, keepdims=True)
@@ -129,10 +122,32 @@ class Belief:
         ])  # fmt: skip
         return self.rng.normal(0.0, 1.0, motion.shape) * sigma
 
+
+class Belief:
+    """Every robot's believed pose, kept from the true poses the world gives each period (see the module)."""
+
+    def __init__(self, noise: Noise, truth: np.ndarray, seed: int) -> None:
+        self.noise = noise
+        self.sensors = Sensors(noise, truth, seed)
+        self.poses = truth.copy()  # the start pose is known
+        keep = noise.localiser_delay + 1
+        self.odometry: deque[np.ndarray] = deque(maxlen=keep)  # the last periods' odometry motions
+
+    def update(self, truth: np.ndarray) -> np.ndarray:
+        """The world's true poses after one more period; the beliefs (N, 3) then."""
+        if self.noise.none:
+            self.poses = truth.copy()
+            return self.poses
+        odometry, arrived = self.sensors.update(truth)
+        self.odometry.append(odometry)
+        self.poses = moved_by(self.poses, odometry)
+        for _, fix in arrived:
+            self.poses = self._replayed(fix)
+        return self.poses
+
     def _replayed(self, fix: np.ndarray) -> np.ndarray:
         """A fix of the pose ``localiser_delay`` periods ago, the odometry since replayed on it."""
         poses = np.array(fix)
-        poses[:, 2] = np.angle(np.exp(1j * poses[:, 2]))
         for odometry in list(self.odometry)[len(self.odometry) - self.noise.localiser_delay :]:
             poses = moved_by(poses, odometry)
         return poses

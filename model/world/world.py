@@ -104,10 +104,12 @@ class World:
     def coverable_area(self) -> float:
         return float(self.coverable.sum()) * self.scenario.cell**2
 
-    def head_start(self, target_ticks: int) -> np.ndarray:
+    def head_start(self, target_ticks: int, scale: float = 1.0) -> np.ndarray:
         """Ticks every replica starts with: Λ* on cells nobody can cover, and Λ*_max − Λ*(x) on the
-        rest (a priority map's lower targets as a head start on one common target)."""
-        return np.where(self.coverable, target_ticks - self.targets, target_ticks).astype(np.int64)
+        rest (a priority map's lower targets as a head start on one common target). ``scale``: every Λ*(x)
+        asked that many times over (a noisy team's cover margin, :func:`model.parameters.coverage_map_of`)."""
+        targets = self.targets if scale == 1.0 else np.rint(self.targets * scale).astype(np.int64)
+        return np.where(self.coverable, np.maximum(target_ticks - targets, 0), target_ticks).astype(np.int64)
 
     def field(self, x: float, y: float) -> np.ndarray:
         """Geodesic distance to the cell of (x, y) from every cell (:func:`model.world.geodesic.distance_fields`)."""

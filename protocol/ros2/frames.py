@@ -10,8 +10,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from model.scenario.map_fit import MapFrame
+from model.world.world import map_frame_of
+
+if TYPE_CHECKING:
+    from model.scenario import Scenario
 
 Pose = tuple[float, float, float]
 
@@ -51,6 +56,13 @@ class ScenarioFrame:
         """A scenario point (units) in the map frame (metres): the inverse of :meth:`to_scenario`."""
         return MapFrame(self.origin, self.yaw).to_map(x * self.metres_per_unit, y * self.metres_per_unit)
 
+    def pose_to_map(self, pose: Pose) -> Pose:
+        """A scenario pose (units) in the map frame (metres, the heading turned by the yaw): the inverse of
+        :meth:`to_scenario`."""
+        x, y, theta = pose
+        map_x, map_y = self.to_map(x, y)
+        return float(map_x), float(map_y), float(MapFrame(self.origin, self.yaw).heading_to_map(theta))
+
     def to_ros_velocity(self, v: float, omega: float) -> tuple[float, float]:
         """(v, ω) in scenario units per time unit as (m/s, rad/s)."""
         return v * self.metres_per_unit / self.seconds_per_unit, omega / self.seconds_per_unit
@@ -77,3 +89,14 @@ def scale_into(v: float, omega: float, max_v: float, max_omega: float) -> tuple[
     if abs(omega) > max_omega:
         factor = min(factor, max_omega / abs(omega))
     return v * factor, omega * factor
+
+
+def frame_of(scenario: Scenario, origin: tuple[float, float] | None = None) -> ScenarioFrame:
+    """The scenario in the robot's map frame: its (0, 0) at ``origin`` if given (its axes the map frame's: a
+    given origin places the scenario unturned, whatever its map's yaw), else where the scenario's map puts it,
+    turned by the map's yaw (the same Nav2 map: the frames then agree; :func:`model.world.world.map_frame_of`,
+    the map's origin when no unknown border was cropped), else at the map frame's (0, 0); its units."""
+    if origin is not None:
+        return ScenarioFrame(origin, scenario.metres_per_unit, scenario.seconds_per_unit)
+    frame = map_frame_of(scenario)
+    return ScenarioFrame(frame.corner, scenario.metres_per_unit, scenario.seconds_per_unit, frame.yaw)

@@ -1,19 +1,23 @@
 """ROS 2 messages as CDR bytes, by rosbags' typestore (no hand-written CDR).
 
 The driver sends ``geometry_msgs/msg/Twist`` or ``TwistStamped`` and reads ``nav_msgs/msg/Odometry`` or
-``geometry_msgs/msg/PoseWithCovarianceStamped``. The definitions are those of the ROS 2 distribution
+``geometry_msgs/msg/PoseWithCovarianceStamped``; the simulator (simulator/) reads the first two and writes the
+others. The definitions are those of the ROS 2 distribution
 named (``jazzy`` by default; these four types are the same in humble, jazzy and kilted), and so are the
 RIHS01 type hashes rmw_zenoh puts in its keys.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
-from agents.ros2.frames import Pose, yaw_of_quaternion
-from agents.ros2.options import TWIST, TWIST_STAMPED
+import numpy as np
+
+from protocol.ros2.frames import Pose, yaw_of_quaternion
+from protocol.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, TWIST, TWIST_STAMPED
 
 DISTRIBUTIONS = ("humble", "jazzy", "kilted")
 
@@ -92,3 +96,63 @@ def decode_pose(payload: bytes, typename: str, distribution: str = "jazzy") -> R
         message.header.frame_id,
         stamp.sec * 1_000_000_000 + stamp.nanosec,
     )
+
+
+def decode_velocity(payload: bytes, typename: str, distribution: str = "jazzy") -> tuple[float, float]:
+    """(linear.x, angular.z) of a Twist or TwistStamped; BadRosMessage if the bytes are not one or either is not
+    finite (a base ignores such a command: it never moves on it)."""
+    try:
+        message = typestore(distribution).deserialize_cdr(payload, typename)
+    except Exception as error:  # rosbags raises several kinds on truncated or foreign bytes
+        raise BadRosMessage(f"not a {typename}: {error}") from error
+    twist = message.twist if typename == TWIST_STAMPED else message
+    linear, angular = float(twist.linear.x), float(twist.angular.z)
+    if not (math.isfinite(linear) and math.isfinite(angular)):
+        raise BadRosMessage(f"{typename} holds a velocity that is not finite ({linear!r}, {angular!r})")
+    return linear, angular
+
+
+def encode_pose(
+    typename: str,
+    pose: Pose,
+    stamp_ns: int,
+    frame_id: str,
+    velocity: tuple[float, float] = (0.0, 0.0),
+    sigma: tuple[float, float] = (0.0, 0.0),
+    distribution: str = "jazzy",
+) -> bytes:
+    """A planar pose as an Odometry (with its twist ``velocity``, m/s and rad/s, child frame base_link) or a
+    PoseWithCovarianceStamped; ``sigma`` (position σ in metres, heading σ in radians) fills the covariance's
+    diagonal (x, y, yaw)."""
+    store = typestore(distribution)
+    types = store.types
+    x, y, theta = pose
+    seconds, nanoseconds = divmod(int(stamp_ns), 1_000_000_000)
+    header = types["std_msgs/msg/Header"](
+        stamp=types["builtin_interfaces/msg/Time"](sec=seconds, nanosec=nanoseconds), frame_id=frame_id
+    )
+    covariance = np.zeros(36)
+    covariance[[0, 7]], covariance[35] = sigma[0] ** 2, sigma[1] ** 2
+    with_covariance = types["geometry_msgs/msg/PoseWithCovariance"](
+        pose=types["geometry_msgs/msg/Pose"](
+            position=types["geometry_msgs/msg/Point"](x=float(x), y=float(y), z=0.0),
+            orientation=types["geometry_msgs/msg/Quaternion"](
+                x=0.0, y=0.0, z=math.sin(theta / 2.0), w=math.cos(theta / 2.0)
+            ),
+        ),
+        covariance=covariance,
+    )
+    if typename == POSE_WITH_COVARIANCE:
+        message = types[POSE_WITH_COVARIANCE](header=header, pose=with_covariance)
+        return bytes(store.serialize_cdr(message, POSE_WITH_COVARIANCE))
+    vector = types["geometry_msgs/msg/Vector3"]
+    twist = types["geometry_msgs/msg/Twist"](
+        linear=vector(x=float(velocity[0]), y=0.0, z=0.0), angular=vector(x=0.0, y=0.0, z=float(velocity[1]))
+    )
+    message = types[ODOMETRY](
+        header=header,
+        child_frame_id="base_link",
+        pose=with_covariance,
+        twist=types["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=np.zeros(36)),
+    )
+    return bytes(store.serialize_cdr(message, ODOMETRY))

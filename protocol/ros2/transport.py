@@ -21,11 +21,11 @@ from typing import TYPE_CHECKING
 
 import zenoh.ext
 
-from agents.ros2.messages import dds_type_name, type_hash
-from agents.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE
+from protocol.ros2.messages import dds_type_name, type_hash
+from protocol.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE
 
 if TYPE_CHECKING:
-    from agents.ros2.options import Ros2Options
+    from protocol.ros2.options import Ros2Options
 
 TRANSPORTS = ("bridge", "rmw-zenoh")
 GID_SIZE = 16

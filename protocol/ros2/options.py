@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from agents.ros2.frames import Pose
+from protocol.ros2.frames import Pose
 
 TWIST = "geometry_msgs/msg/Twist"
 TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
@@ -35,6 +35,8 @@ class Ros2Options:
     distribution: str = "jazzy"
     connect: tuple[str, ...] = ()  # endpoints of the robot's bridge or router, if not the team's bus
     origin: tuple[float, float] | None = None  # map-frame (x, y) of the scenario's (0, 0); None: see frame_of
+    sim_time: bool = False  # the base is anicov sim's, on the team's clock (ROS's use_sim_time)
+    lockstep: bool = False  # the team's clock; with sim_time each step waits for the next simulated instant
 
     @property
     def command_typename(self) -> str:
