@@ -18,7 +18,8 @@ from rosbags.typesys import Stores, get_typestore
 
 from agents.ros2.driver import Ros2Robot
 from model.scenario import Scenario
-from protocol.ros2.options import Ros2Options
+from protocol.ros2.messages import encode_pose
+from protocol.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, Ros2Options
 from protocol.session import zenoh_config
 from tests.teamrun import free_port, limit
 
@@ -262,6 +263,38 @@ def test_a_localiser_pose_corrects_map_from_odom_and_odometry_carries_it_on():
         assert robot.pose() == pytest.approx((40.0, 60.0, math.pi / 2))
         base.stop_odometry()
         robot.close()
+
+
+def test_against_the_simulator_in_lockstep_each_step_waits_for_the_next_simulated_instant():
+    """--ros-sim-time in lockstep (anicov sim): a step acts on the instant after the last one acted on, however
+    often the current one is repeated; a fix stamped ahead of the odometry waits for it; nothing is sent but
+    the steps' commands (no watchdog zero, no stop: a zero would count as the next step's command)."""
+    options = Ros2Options(namespace="bot1", localiser_topic="amcl_pose", sim_time=True, lockstep=True)
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = Ros2Robot(driver, options, SCENARIO, agent=0)
+
+        def put(topic: str, typename: str, pose: tuple[float, float, float], stamp: int) -> None:
+            base_session.put(f"bot1/{topic}", encode_pose(typename, pose, stamp, "map"))
+
+        put("amcl_pose", POSE_WITH_COVARIANCE, (1.0, 2.0, 0.0), 0)  # before any odometry of its instant
+        put("odom", ODOMETRY, (0.0, 0.0, 0.0), 0)
+        assert wait_until(robot.has_pose)
+        assert robot.current_pose() == pytest.approx((20.0, 40.0, 0.0))  # 0.05 m units
+        robot.command(0.5, 0.0)
+        assert base.next()[0].linear.x == pytest.approx(0.5 * 0.05 / 0.05)
+        acted: list = []
+        step = threading.Thread(target=lambda: acted.append(robot.current_pose()), daemon=True)
+        step.start()
+        put("odom", ODOMETRY, (0.0, 0.0, 0.0), 0)  # the simulator repeating instant 0 while it waits
+        step.join(timeout=1.0)
+        assert step.is_alive()  # still waiting: the repeat is not the next instant
+        put("odom", ODOMETRY, (0.1, 0.0, 0.0), 100_000_000)
+        step.join(timeout=limit(30))
+        assert acted == [pytest.approx((22.0, 40.0, 0.0))]
+        robot.close()  # sends no stop
+        time.sleep(3.5)  # the watchdog's 3 periods of 1 s, had it run
+        assert base.received.empty() and robot.counts()["commands_sent"] == 1
 
 
 def test_a_payload_that_is_not_a_pose_is_rejected_and_counted():

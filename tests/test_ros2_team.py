@@ -21,6 +21,7 @@ from tests.teamrun import (
     free_port,
     launcher_command,
     limit,
+    processes_of,
     run,
     unique_team,
     wait_for,
@@ -265,3 +266,66 @@ def test_a_stale_pose_stops_the_robot_and_a_lost_router_moves_it_only_after_a_fr
         # Whatever reached the base after the router came back and before the fresh pose was a zero.
         moving = team.moving_after(back)
         assert moving[0]["t"] >= fresh - 0.002, (moving[0]["t"], fresh)
+
+
+SIM_ROOMS = """domain = [16.0, 10.0]
+cell = 1.0
+range = 4.0
+robot_radius = 0.3
+occlusion = true
+agents = 2
+seed = 3
+controller = "anicov"
+physics = "mujoco"
+obstacles = [[[8.0, 0.0], [9.0, 0.0], [9.0, 4.0], [8.0, 4.0]], [[8.0, 6.0], [9.0, 6.0], [9.0, 10.0], [8.0, 10.0]]]
+
+[noise]
+odometry_per_metre = 0.01
+odometry_per_radian = 0.01
+localiser_sigma = 0.05
+localiser_heading_deg = 2.0
+localiser_rate = 10.0
+localiser_latency = 0.1
+command_latency = 0.1
+"""
+"""Two rooms and a door, two robots with bodies and the filter, the issue's noise (issue 37)."""
+
+
+def test_agents_drive_the_simulators_bases_in_lockstep_to_complete_coverage_in_truth(tmp_path):
+    """launch_team.py --robot ros2 --sim-bases: anicov sim plays both bases in the physics world; the agents read
+    its odometry and its localiser's fixes (amcl_pose) as they would a real robot's, on the team's clock."""
+    config = tmp_path / "rooms.toml"
+    config.write_text(SIM_ROOMS)
+    out, team = tmp_path / "team", unique_team()
+    launched = run(
+        launcher_command("--config", str(config), "--robot", "ros2", "--sim-bases", "--out", str(out), team=team),
+        timeout=300,
+    )
+    assert launched.returncode == 0, launched.stderr + launched.stdout
+    assert "launch_team (lockstep" in launched.stdout and "anicov sim" in launched.stdout
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] and summary["physical_contacts"] == 0
+    assert summary["true_coverage"] >= 0.995  # the issue's goal at declared completion, with the cover margin
+    assert summary["simulated_steps"] == summary["steps"]  # lockstep: the world stepped once per team step
+    assert summary["commands_rejected"] == 0 and summary["commands_received"] == 2 * summary["steps"]
+    for agent in range(2):
+        robot = json.loads((out / "logs" / f"agent-{agent}.counts.json").read_text())["robot"]
+        assert robot["localiser_poses"] > summary["steps"] // 2 and robot["stale_spells"] == 0
+    rows = (out / "sim-truth.csv").read_text().splitlines()
+    assert len(rows) == 1 + 2 * (summary["steps"] + 1)
+    assert (out / "recording.rrd").stat().st_size > 0
+    assert wait_for(lambda: not processes_of(team), 30), processes_of(team)
+
+
+def test_physics_over_the_bus_needs_the_simulators_bases_and_they_need_physics(tmp_path):
+    physical = tmp_path / "physical.toml"
+    physical.write_text(SIM_ROOMS)
+    refused = run(launcher_command("--config", str(physical), "--out", str(tmp_path / "a")), timeout=120)
+    assert refused.returncode == 2 and "scenario key 'physics'" in refused.stderr and "--sim-bases" in refused.stderr
+    kinematic = tmp_path / "kinematic.toml"
+    kinematic.write_text(SIM_ROOMS.split("physics = ")[0])
+    refused = run(
+        launcher_command("--config", str(kinematic), "--robot", "ros2", "--sim-bases", "--out", str(tmp_path / "b")),
+        timeout=120,
+    )
+    assert refused.returncode == 2 and "--sim-bases" in refused.stderr and '"mujoco"' in refused.stderr
