@@ -13,7 +13,8 @@ It plays every robot's ROS 2 base on the bus with the keys and messages of the s
 
 A malformed command is rejected, logged and counted; it never moves a base. When the coordinator declares the
 run over (its ``done`` or ``abort`` on the run's control key) the truth's map stops taking what the cameras
-see, so ``true_coverage`` is the truth at the declared completion. At the end (SIGTERM, Ctrl-C) it writes
+see, so ``true_coverage`` is the truth at the declared completion: in lockstep after the team's last step
+(the world's step k is the team's), in realtime when the message arrives. At the end (SIGTERM, Ctrl-C) it writes
 ``sim.json`` (contacts, the truth's coverage, counters) and ``sim-truth.csv`` (the true poses, map frame).
 """
 
@@ -113,6 +114,7 @@ class TeamWatch:
         self.live: set[int] = set()
         self.seen_agents = False
         self.over = False
+        self.steps: int | None = None  # the team's steps when the coordinator declared the run over
 
     @property
     def ended(self) -> bool:
@@ -135,7 +137,7 @@ class TeamWatch:
             return  # not ours to count: the coordinator's own readers reject and count it
         if isinstance(message, RunControl) and message.kind in ("done", "abort") and not self.over:
             with self.inbox.changed:
-                self.over = True
+                self.over, self.steps = True, message.step
                 self.inbox.changed.notify_all()
             log.info("the run is over (%s at step %d): the truth's map stops here", message.kind, message.step)
 
@@ -144,14 +146,15 @@ class Publishers:
     """Each base's odometry publisher and, with a localiser, its fixes' publisher."""
 
     def __init__(self, session: zenoh.Session, options: SimOptions, bases: SimulatedBases) -> None:
-        self.odometry = [
-            session.declare_publisher(bridge_key(options.namespace(i), "odom")) for i in range(bases.agents)
-        ]
-        self.fixes = [
-            session.declare_publisher(bridge_key(options.namespace(i), options.localiser_topic))
-            for i in range(bases.agents)
-            if bases.localiser
-        ]
+        # Lockstep: a lost pose or fix would change what a robot believes, and so the run; none may be dropped.
+        # Realtime: a late pose is worth less than the next, as on a robot.
+        congestion = zenoh.CongestionControl.BLOCK if options.clock == "lockstep" else zenoh.CongestionControl.DROP
+
+        def publisher(agent: int, topic: str) -> zenoh.Publisher:
+            return session.declare_publisher(bridge_key(options.namespace(agent), topic), congestion_control=congestion)
+
+        self.odometry = [publisher(i, "odom") for i in range(bases.agents)]
+        self.fixes = [publisher(i, options.localiser_topic) for i in range(bases.agents) if bases.localiser]
         noise = bases.noise
         self.sigma = (noise.localiser_sigma * bases.scenario.metres_per_unit, noise.localiser_heading)
         self.published = 0
@@ -207,12 +210,14 @@ def step_in_lockstep(
             )
             ready = ready and inbox.all_in(watch.live)
             commands = inbox.take(set(watch.live), 0.0) if ready else None
-        if commands is None:
-            publishers.publish([Reading(r.agent, r.stamp_ns, r.odometry, r.velocity) for r in latest])
+        if commands is None:  # the fixes too: a late driver needs the first to place its odometry in the map
+            publishers.publish(latest)
             continue
         for agent, (linear, angular) in enumerate(commands):
             bases.command(agent, linear, angular)
-        bases.sensing = not watch.over
+        # The world's step k is the team's step k: the truth senses the steps the team took, however late
+        # the coordinator's done overtakes a command on its way here.
+        bases.sensing = watch.steps is None or bases.step < watch.steps
         latest = bases.advance()
         publishers.publish(latest)
 

@@ -83,3 +83,13 @@ def test_with_noise_the_truth_is_kept_beside_the_belief_and_written_out(tmp_path
     lines = (tmp_path / "truth.csv").read_text().splitlines()
     assert lines[0] == "t,agent,x,y,theta,x_believed,y_believed,theta_believed"
     assert len(lines) == 1 + len(result.trace) * 4  # (that the noise repeats by its seed: test_physics_noise)
+
+
+def test_the_shipped_two_rooms_are_the_ones_measured_here():
+    """scenarios/physics-rooms.toml (the README's physics command) is this file's rooms with the issue's noise."""
+    from pathlib import Path
+
+    from model.scenario import load_scenario
+
+    shipped = load_scenario(Path(__file__).resolve().parent.parent / "scenarios" / "physics-rooms.toml")
+    assert shipped == validate({**ROOMS, "controller": "anicov", "physics": "mujoco", "noise": NOISE})

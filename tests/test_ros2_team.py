@@ -230,7 +230,7 @@ def test_sigterm_of_the_agent_sends_zero_and_sigkill_leaves_the_base_to_its_own_
         team.processes["agent-0.restart"].kill()  # no chance to send anything
         assert wait_for(lambda: team.timeout_stop_after(killed) is not None, timeout=60)
         stop = team.timeout_stop_after(killed)
-        assert abs(stop["v"]) > 0  # it was moving: its own watchdog stopped it
+        assert abs(stop["v"]) + abs(stop["omega"]) > 0  # it was moving (or turning): its own watchdog stopped it
         assert stop["t"] - killed <= COMMAND_TIMEOUT + BASE_TICK + SLACK, stop["t"] - killed
 
 
