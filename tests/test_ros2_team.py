@@ -268,7 +268,7 @@ def test_a_stale_pose_stops_the_robot_and_a_lost_router_moves_it_only_after_a_fr
         assert moving[0]["t"] >= fresh - 0.002, (moving[0]["t"], fresh)
 
 
-SIM_ROOMS = """domain = [16.0, 10.0]
+SIM_ROOMS = """domain = [12.0, 8.0]
 cell = 1.0
 range = 4.0
 robot_radius = 0.3
@@ -277,7 +277,7 @@ agents = 2
 seed = 3
 controller = "anicov"
 physics = "mujoco"
-obstacles = [[[8.0, 0.0], [9.0, 0.0], [9.0, 4.0], [8.0, 4.0]], [[8.0, 6.0], [9.0, 6.0], [9.0, 10.0], [8.0, 10.0]]]
+obstacles = [[[6.0, 0.0], [7.0, 0.0], [7.0, 3.0], [6.0, 3.0]], [[6.0, 5.0], [7.0, 5.0], [7.0, 8.0], [6.0, 8.0]]]
 
 [noise]
 odometry_per_metre = 0.01
