@@ -19,7 +19,7 @@ from protocol.ros2.messages import decode_pose, encode_velocity
 from protocol.ros2.options import ODOMETRY
 from protocol.session import zenoh_config
 from runtime.lifecycle import EXIT_SIGTERM
-from tests.teamrun import anicov_command, free_port, limit, running, unique_team, wait_for
+from tests.teamrun import anicov, anicov_command, free_port, limit, running, unique_team, wait_for
 
 ROOM = """domain = [12.0, 8.0]
 cell = 1.0
@@ -120,3 +120,10 @@ def test_in_realtime_the_world_steps_on_the_wall_clock_and_a_silent_base_stops_o
         process.send_signal(signal.SIGTERM)
         assert process.wait(timeout=limit(30)) == EXIT_SIGTERM
     assert json.loads((bus.out / "sim.json").read_text())["simulated_steps"] >= 35
+
+
+def test_a_scenario_without_physics_is_refused_naming_the_key(tmp_path):
+    config = tmp_path / "kinematic.toml"
+    config.write_text(ROOM.replace('physics = "mujoco"\n', ""))
+    refused = anicov("sim", "--config", str(config), "--connect", f"tcp/127.0.0.1:{free_port()}", timeout=120)
+    assert refused.returncode == 2 and "scenario key 'physics'" in refused.stderr and '"mujoco"' in refused.stderr
