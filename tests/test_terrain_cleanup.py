@@ -5,6 +5,8 @@ pieces give each station to one robot."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -20,6 +22,7 @@ from model.controllers.anicov.terrain_cleanup import (
     residual_lack,
     station_patch,
 )
+from model.controllers.anicov.terrain_routes import hop_path
 from model.controllers.anicov.terrain_stations import ANGLES
 from model.world.world import world_of
 from tests.test_terrain_stations import ROOMS, deposit_of
@@ -88,6 +91,24 @@ def test_a_cell_seen_past_a_wall_s_corner_gets_a_station_that_sees_it_from_all_r
             assert deposit.stares(near[None, :], ANGLES)[int(flat)].sum() > 0.0
         assert stares[int(flat)].sum() > 0.0
     assert found > 0.9 * len(cells[::7])
+
+
+def test_a_seer_shifted_by_a_noisy_localisers_wide_face_radius_stays_where_free_paths_go():
+    """With a localiser's σ of 0.1 the face radius is 0.6 cells and a seer is tried up to 1.8 cells off: each
+    station found lies in a cell of the team's space, as the free paths find it (a shifted station off it
+    crashed the MRPT lab's noisy run: 'no free path joins')."""
+    noisy = ROOMS.with_overrides(physics="mujoco", noise={"localiser_sigma": 0.1, "localiser_rate": 10.0})
+    world, deposit = world_of(noisy), deposit_of(noisy)
+    assert face_radius_of(noisy) == pytest.approx(0.6)
+    found = []
+    for flat in world.coverable.ravel().nonzero()[0][::5]:
+        got = _sure_seer(world, deposit, int(flat), frozenset())
+        if got is not None:
+            found.append(got[0])
+    assert len(found) > 20
+    for x, y in found:
+        assert world.reachable[math.floor(y / noisy.cell), math.floor(x / noisy.cell)]
+        hop_path(world, np.array([12.5, 8.5]), np.array([x, y]))  # a free path from the door joins it
 
 
 def test_a_patch_finishes_what_is_left_near_the_station_and_nothing_when_all_is_done():
