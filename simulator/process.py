@@ -66,6 +66,7 @@ class CommandInbox:
     write, the stepping loop reads)."""
 
     def __init__(self, agents: int) -> None:
+        self.agents = agents
         self.latest = [(0.0, 0.0)] * agents
         self.fresh = [False] * agents
         self.received_at = [-float("inf")] * agents
@@ -120,6 +121,12 @@ class TeamWatch:
     def ended(self) -> bool:
         """The run was declared over and every agent has left: nothing will command a base again."""
         return self.over and self.seen_agents and not self.live
+
+    def all_in(self, step: int) -> bool:
+        """Every live agent's command of the step is in (under the inbox's lock). The first step also waits until
+        the whole team is live, as the coordinator's first go does: an agent whose token reached us after a
+        teammate's first command must not have its base left standing at step 0."""
+        return (step > 0 or len(self.live) >= self.inbox.agents) and self.inbox.all_in(self.live)
 
     def on_liveliness(self, sample: zenoh.Sample) -> None:
         agent = agent_of_key(f"{sample.key_expr}")
@@ -206,9 +213,9 @@ def step_in_lockstep(
     while not stop.stopped and not watch.ended:
         with inbox.changed:
             ready = inbox.changed.wait_for(
-                lambda: inbox.all_in(watch.live) or stop.stopped or watch.ended, timeout=REPEAT_PERIOD
+                lambda: watch.all_in(bases.step) or stop.stopped or watch.ended, timeout=REPEAT_PERIOD
             )
-            ready = ready and inbox.all_in(watch.live)
+            ready = ready and watch.all_in(bases.step)
             commands = inbox.take(set(watch.live), 0.0) if ready else None
         if commands is None:  # the fixes too: a late driver needs the first to place its odometry in the map
             publishers.publish(latest)

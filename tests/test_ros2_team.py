@@ -14,6 +14,8 @@ from contextlib import ExitStack, contextmanager
 from datetime import datetime
 from pathlib import Path
 
+import pytest
+
 from tests.teamrun import (
     ROOT,
     anicov,
@@ -37,6 +39,9 @@ SLACK = 0.3  # scheduling on a loaded 2-core machine: what a stated time may be 
 A_SECOND_OF_CONTROL = 40  # commands: what the control loop sends in a second, however long a busy machine takes
 
 
+@pytest.mark.slow  # 30 s of real time, the suite's longest ROS 2 test: outside the default suite (its 10-minute
+# budget was reached, 609 s at 2026-12-07); the default suite keeps ROS 2 bases driven in realtime (the tests below)
+# and a ROS 2 team to completion (the simulator's, lockstep). Run with -m slow.
 def test_three_agents_drive_three_ros2_bases_to_complete_coverage(tmp_path):
     """The paper's scenario scaled (scenarios/ros2-paper.toml: 1 m/s, 40 Hz control) in a 3.5 m room (70 x 70
     units instead of the file's 100 x 100: 18 s of driving instead of 36)."""
