@@ -130,7 +130,7 @@ class TeamWatch:
 
     def on_liveliness(self, sample: zenoh.Sample) -> None:
         agent = agent_of_key(f"{sample.key_expr}")
-        if agent is None:
+        if agent is None or agent >= self.inbox.agents:  # not one of this scenario's robots: no base to play
             return
         with self.inbox.changed:
             (self.live.add if sample.kind == zenoh.SampleKind.PUT else self.live.discard)(agent)

@@ -20,6 +20,8 @@ from model.scenario import Scenario, ScenarioError, load_scenario
 PAPER = Scenario(stations=False)  # the spiral (tests/test_stations.py has the stations)
 
 
+@pytest.mark.slow  # 20 s of CPU on one of the 2 cores, one seed's regression run: outside the default suite (-m slow),
+# which stood at 609 s from a fresh clone on 2026-12-07, over its 10-minute budget
 def test_a_team_on_a_long_strip_finishes_its_last_small_blobs():
     """Found on the 200 x 50 strip (R = 10): a one-cell blob left at the end was shuttled over for ever
     when progress took the pass's way back for its way out (N = 2, seed 1: now complete)."""

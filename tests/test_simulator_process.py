@@ -81,6 +81,7 @@ def simulator(tmp_path: Path, clock: str, *flags: str) -> Iterator[tuple[Bus, ob
 def test_in_lockstep_the_world_steps_once_every_live_agents_command_is_in(tmp_path):
     with simulator(tmp_path, "lockstep") as (bus, process):
         assert wait_for(lambda: bus.stamped(0), 60), "the simulator never published its bases' start poses"
+        stranger = bus.session.liveliness().declare_token(bus.keys.alive("agent", 7))  # no such robot: ignored
         tokens = [bus.session.liveliness().declare_token(bus.keys.alive("agent", agent)) for agent in (0, 1)]
         start = bus.newest(0)
         bus.command(0, 0.5)
@@ -92,6 +93,7 @@ def test_in_lockstep_the_world_steps_once_every_live_agents_command_is_in(tmp_pa
         assert wait_for(lambda: bus.stamped(PERIOD_NS), 30)
         assert bus.newest(0)[1] > start[1] - 1.0  # (decoded and in the map frame)
         tokens[1].undeclare()  # agent 1 left: its base stands, and the world no longer waits for it
+        stranger.undeclare()
         bus.command(0, 0.5)
         assert wait_for(lambda: bus.stamped(2 * PERIOD_NS), 30)
         assert not bus.stamped(3 * PERIOD_NS)  # one command, one step

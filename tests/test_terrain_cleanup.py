@@ -101,11 +101,11 @@ def test_a_seer_shifted_by_a_noisy_localisers_wide_face_radius_stays_where_free_
     world, deposit = world_of(noisy), deposit_of(noisy)
     assert face_radius_of(noisy) == pytest.approx(0.6)
     found = []
-    for flat in world.coverable.ravel().nonzero()[0][::5]:
+    for flat in world.coverable.ravel().nonzero()[0][::10]:
         got = _sure_seer(world, deposit, int(flat), frozenset())
         if got is not None:
             found.append(got[0])
-    assert len(found) > 20
+    assert len(found) > 10
     for x, y in found:
         assert world.reachable[math.floor(y / noisy.cell), math.floor(x / noisy.cell)]
         hop_path(world, np.array([12.5, 8.5]), np.array([x, y]))  # a free path from the door joins it
