@@ -12,12 +12,35 @@ import itertools
 import math
 
 import numpy as np
+from numba import njit
 from scipy.sparse import csc_matrix
 
 from model.paper.coverage_map import CoverageMap, add_window
 from model.scenario import Scenario
 from model.world.ground import Ground, open_ground
 from model.world.wedge import sense_wedge_among
+
+
+@njit(cache=True)
+def _cells_of(
+    window: np.ndarray, row0: int, col0: int, width: int, period_steps: int, target_ticks: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The window's non-zero cells in row-major order, as flat indices of a grid ``width`` wide, and each one's
+    ticks times ``period_steps`` over ``target_ticks``: what ``np.nonzero`` and indexing gave, in one call (the
+    campus at N = 1 asks half a million stares; the Python around the kernel cost as much as the kernel)."""
+    count = 0
+    for value in window.ravel():
+        count += value != 0
+    flat, added = np.empty(count, dtype=np.int64), np.empty(count, dtype=np.float64)
+    k = 0
+    for row in range(window.shape[0]):
+        for col in range(window.shape[1]):
+            value = window[row, col]
+            if value != 0:
+                flat[k] = (row + row0) * width + col + col0
+                added[k] = (value * period_steps) / target_ticks
+                k += 1
+    return flat, added
 
 
 class Deposit:
@@ -46,9 +69,7 @@ class Deposit:
         """One plan period facing ``theta`` from (x, y): (flat indices of the cells it reaches, Λ* added to
         each). The robot stands still, so every step of the period adds the same window."""
         row0, col0, window = self.window(x, y, theta)
-        rows, cols = np.nonzero(window)
-        flat = (rows + row0) * self.shape[1] + cols + col0
-        return flat, window[rows, cols] * self.period_steps / self.target_ticks
+        return _cells_of(window, row0, col0, self.shape[1], self.period_steps, self.target_ticks)
 
     def stare(self, x: float, y: float, theta: float) -> np.ndarray:
         """One plan period facing ``theta`` from (x, y), per cell (Λ*)."""
