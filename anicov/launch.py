@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 
 from agents.command import add_deltas_argument
 from anicov.ros2_team import (
+    SIM_LOCALISER_TOPIC,
     add_ros2_team_arguments,
     check_ros2_team,
     merge_simulator_figures,
@@ -290,7 +291,8 @@ def start_bases(args: argparse.Namespace, scenario: Scenario, out_dir: Path) -> 
     logs = out_dir / "logs"
     bases = [spawn(f"base-{i}", command, logs) for i, command in enumerate(test_base_commands(args, scenario, logs))]
     if args.sim_bases:
-        bases.append(spawn("sim", child_command("sim", args, ["--out", str(out_dir)]), logs))
+        flags = ["--out", str(out_dir), "--localiser-topic", SIM_LOCALISER_TOPIC]  # where the agents read fixes
+        bases.append(spawn("sim", child_command("sim", args, flags), logs))
     return bases
 
 

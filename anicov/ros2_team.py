@@ -24,7 +24,8 @@ from model.scenario import Scenario, ScenarioError
 
 TEST_BASE = Path(__file__).resolve().parent.parent / "deploy" / "ros2" / "test_base.py"
 SIM_LOCALISER_TOPIC = "amcl_pose"
-"""Where anicov sim publishes a ``[noise]`` localiser's fixes (its default ``--localiser-topic``)."""
+"""Where anicov sim publishes a ``[noise]`` localiser's fixes and the agents read them (the launcher gives both
+the topic, so the two cannot disagree)."""
 ODOMETRY_RATE = 30.0
 """Hz of the stand-in bases' odometry: a typical wheel-odometry rate (TurtleBot 4: 20-62 Hz)."""
 

@@ -114,8 +114,12 @@ class TeamWatch:
         self.limits, self.inbox = Limits.of(scenario), inbox
         self.live: set[int] = set()
         self.seen_agents = False
-        self.over = False
         self.steps: int | None = None  # the team's steps when the coordinator declared the run over
+
+    @property
+    def over(self) -> bool:
+        """The coordinator declared the run over (done or abort)."""
+        return self.steps is not None
 
     @property
     def ended(self) -> bool:
@@ -144,7 +148,7 @@ class TeamWatch:
             return  # not ours to count: the coordinator's own readers reject and count it
         if isinstance(message, RunControl) and message.kind in ("done", "abort") and not self.over:
             with self.inbox.changed:
-                self.over, self.steps = True, message.step
+                self.steps = message.step
                 self.inbox.changed.notify_all()
             log.info("the run is over (%s at step %d): the truth's map stops here", message.kind, message.step)
 
@@ -164,7 +168,6 @@ class Publishers:
         self.fixes = [publisher(i, options.localiser_topic) for i in range(bases.agents) if bases.localiser]
         noise = bases.noise
         self.sigma = (noise.localiser_sigma * bases.scenario.metres_per_unit, noise.localiser_heading)
-        self.published = 0
 
     def publish(self, readings: list[Reading]) -> None:
         """A base's fixes go before its odometry: the driver pairs a fix with the odometry of its stamp, and
@@ -175,7 +178,6 @@ class Publishers:
             self.odometry[reading.agent].put(
                 encode_pose(ODOMETRY, reading.odometry, reading.stamp_ns, "odom", velocity=reading.velocity)
             )
-        self.published += 1
 
 
 def run_simulator(scenario: Scenario, options: SimOptions, config: zenoh.Config, stop: StopFlag) -> int:
