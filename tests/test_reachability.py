@@ -40,3 +40,13 @@ def test_an_objective_in_a_wall_or_a_pocket_moves_to_the_nearest_reachable_cell(
     assert moved[0].tolist() == [2.2, 3.3]  # already where a robot can go
     assert moved[1].tolist() == [4.5, 4.5]  # the nearest reachable cell centre
     assert moved[2].tolist() == [4.5, 9.5]  # off the grid: clamped, then moved
+
+
+def test_a_point_past_the_edge_of_a_reachable_border_cell_is_moved_onto_the_grid():
+    # A robot of an unbounded map (obstacles, no map) may stand past the domain's edge; clamped into the edge
+    # cell it stayed off the grid, and the free path from it indexed past the field (issue 37's noisy rooms).
+    reachable = np.ones((16, 24), dtype=bool)
+    moved = nearest_reachable(reachable, np.array([[14.39, 16.22], [-0.3, 5.5], [3.0, 4.0]]), 1.0)
+    assert moved[0].tolist() == [14.5, 15.5]
+    assert moved[1].tolist() == [0.5, 5.5]
+    assert moved[2].tolist() == [3.0, 4.0]  # x / cell on a cell's edge: its own cell, reachable

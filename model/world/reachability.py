@@ -89,7 +89,9 @@ def coverable_cells(
 
 def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) -> np.ndarray:
     """Each point (K, 2) moved to the centre of the nearest reachable cell, unless its own cell is
-    reachable (then it stays as it is)."""
+    reachable (then it stays as it is). A point off the grid has no cell of its own: it is moved (a robot of
+    an unbounded map may stand past its edge; clamped into the grid's edge cell, it stayed where no free path
+    starts). Its cell is floor(x / cell), as the free paths find it."""
     rows, cols = reachable.shape
     cells = np.argwhere(reachable)
     if len(cells) == 0:
@@ -97,8 +99,8 @@ def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) ->
     centres = (cells[:, ::-1] + 0.5) * cell  # (x, y) of each reachable cell
     moved = np.array(points, dtype=np.float64, copy=True).reshape(-1, 2)
     for k, (x, y) in enumerate(moved):
-        row, col = min(max(int(y // cell), 0), rows - 1), min(max(int(x // cell), 0), cols - 1)
-        if not reachable[row, col]:
+        row, col = math.floor(y / cell), math.floor(x / cell)
+        if not (0 <= row < rows and 0 <= col < cols and reachable[row, col]):
             moved[k] = centres[int(np.argmin(np.hypot(centres[:, 0] - x, centres[:, 1] - y)))]
     return moved
 
