@@ -24,7 +24,7 @@ from numba.typed import List
 from anicov.plugin_engine import advance_plugin_team
 from anicov.radio_engine import run_ranged
 from anicov.run_parts import Snapshots, finish_run, objective_fields
-from model.controllers import controller_of, law_parameters
+from model.controllers import controller_of, law_of, law_parameters
 from model.controllers.interface import Pilot
 from model.paper.coverage_map import CoverageMap, add_window
 from model.parameters import coverage_map_of, safety_parameters, starting_poses
@@ -113,7 +113,7 @@ def run_scenario(
     elsewhere = _another_engine(scenario, coverage_map, poses, advance, record_trace, progress)
     if elsewhere is not None:
         return elsewhere
-    law, world = controller.law(scenario, coverage_map.target_ticks), world_of(scenario)
+    law, world = law_of(controller, scenario, coverage_map.target_ticks), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     looks = np.full((scenario.agents, 2), np.nan)  # nothing looked at yet (model.step.no_look)
     planner, block = watched_planner(scenario, controller.planner(scenario)), controller.plan_steps(scenario)

@@ -20,7 +20,7 @@ from collections.abc import Callable
 import numpy as np
 
 from anicov.run_parts import Snapshots, finish_run, objective_fields
-from model.controllers import controller_of
+from model.controllers import controller_of, law_of
 from model.paper.coverage_map import CoverageMap
 from model.parameters import safety_parameters
 from model.physics.noise import Belief, noise_of
@@ -43,7 +43,7 @@ def run_physics(
     """One team to full coverage or ``max_time``, its robots moved by the physics world; ``advance`` is the
     engine's step (:func:`anicov.engine.advance_team`, or a plug-in's), taken one step at a time."""
     controller = controller_of(scenario)
-    law, world = controller.law(scenario, coverage_map.target_ticks), world_of(scenario)
+    law, world = law_of(controller, scenario, coverage_map.target_ticks), world_of(scenario)
     safety, memory = safety_parameters(scenario), np.zeros((scenario.agents, MEMORY_SIZE), dtype=np.int64)
     looks = np.full((scenario.agents, 2), np.nan)
     planner, block = watched_planner(scenario, controller.planner(scenario)), controller.plan_steps(scenario)

@@ -38,6 +38,8 @@ class LawParameters(NamedTuple):
     weave_amplitude: float = 0.0  # the anicov controller's weave, radians (model.controllers.anicov.weave; 0: straight)
     weave_wavelength: float = 1.0  # its wavelength, units
     face_radius: float = 0.0  # the anicov controller's stations: a carrot this near is a bearing to face (0: none)
+    position_doubt: float = 0.0  # how far off its belief a robot may stand: its map takes the sure coverage (0: exact)
+    heading_doubt: float = 0.0  # and how far its heading may be off, radians (model.paper.sensing.sure_sensing_ability)
 
 
 @njit(cache=True)
@@ -65,6 +67,7 @@ def read_wedge(
         law.cell,
         ground,
         teammates,
+        (law.position_doubt, law.heading_doubt),
     )
 
 

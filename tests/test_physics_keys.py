@@ -1,8 +1,11 @@
 """model.scenario.physics_keys: physics = "kinematic" | "mujoco" and the [robot] table, each error naming its key."""
 
+import math
+
 import pytest
 
 from model.scenario import ScenarioError, validate
+from model.scenario.physics_keys import cover_margin_of, sure_doubt_of
 
 BODY = {"robot_radius": 0.3}
 
@@ -37,3 +40,15 @@ def test_the_robot_table_is_kept_sorted_and_survives_overrides():
 def test_bad_physics_keys_name_the_key(values, message):
     with pytest.raises(ScenarioError, match=message):
         validate(values)
+
+
+def test_the_sure_rule_doubts_the_pose_by_sure_sigmas_times_the_localiser_sigma():
+    noisy = {**BODY, "physics": "mujoco", "noise": {"localiser_sigma": 0.05, "localiser_heading_deg": 2.0}}
+    assert sure_doubt_of(validate(noisy)) == (0.0, 0.0)  # the cover margin is the default rule
+    sure = validate({**noisy, "noise": {**noisy["noise"], "sure_sigmas": 2}})
+    assert sure_doubt_of(sure) == pytest.approx((0.1, math.radians(4.0)))
+    assert sure_doubt_of(validate({})) == (0.0, 0.0)
+    only_rule = validate({**BODY, "physics": "mujoco", "noise": {"sure_sigmas": 2}})
+    assert sure_doubt_of(only_rule) == (0.0, 0.0) and cover_margin_of(only_rule) == 0.0  # a rule is not noise
+    with pytest.raises(ScenarioError, match=r"noise\.sure_sigmas': expected a non-negative number"):
+        validate({**BODY, "physics": "mujoco", "noise": {"sure_sigmas": -1}})

@@ -9,9 +9,10 @@ import textwrap
 
 import pytest
 
-from model.controllers import BUILT_IN, Controller, ControllerError, canonical_name, controller_of
+from model.controllers import BUILT_IN, Controller, ControllerError, canonical_name, controller_of, law_of
 from model.controllers.registry import ENTRY_POINT_GROUP, controller_class
 from model.scenario import ScenarioError, validate
+from model.scenario.physics_keys import sure_doubt_of
 
 GOOD = """
 from model.controllers import Controller
@@ -126,3 +127,15 @@ def test_the_scenario_check_asks_the_controller_what_it_supports(plugin_dir, val
 def test_the_paper_controllers_support_walls_bodies_and_local_planning():
     for name in ("paper", "paper-literal", "paper-eq16"):
         assert validate({"controller": name, "robot_radius": 0.3, "planning": "local"}).controller == name
+
+
+@pytest.mark.parametrize("name", ["paper", "anicov"])
+def test_the_law_of_a_robot_unsure_of_its_pose_carries_the_scenario_doubt(name):
+    body = {"robot_radius": 0.3, "physics": "mujoco", "controller": name}
+    noise = {"localiser_sigma": 0.05, "localiser_heading_deg": 2.0}
+    exact = validate({**body, "noise": noise})
+    sure = validate({**body, "noise": {**noise, "sure_sigmas": 2}})
+    assert law_of(controller_of(exact), exact, 100).position_doubt == 0.0
+    law = law_of(controller_of(sure), sure, 100)
+    assert (law.position_doubt, law.heading_doubt) == pytest.approx(sure_doubt_of(sure))
+    assert law._replace(position_doubt=0.0, heading_doubt=0.0) == controller_of(sure).law(sure, 100)

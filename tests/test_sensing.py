@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from model.paper.fixed_point import COVERAGE_SCALE
 from model.paper.metrics import total_sensing_ability
-from model.paper.sensing import lack_of_coverage, sensing_ability
+from model.paper.sensing import lack_of_coverage, sensing_ability, sure_sensing_ability
 from model.world.ground import NO_POSITIONS, Ground, open_ground
 from model.world.wedge import sense_wedge
 
@@ -33,6 +33,47 @@ def test_sensing_ability_matches_eq2_and_is_bounded(r, offset):
         assert value == pytest.approx(ALPHA * (R - r) * (F - offset) / (R * F))
     else:
         assert value == 0.0
+
+
+@given(st.floats(0.0, 30.0), st.floats(0.0, math.pi), st.floats(0.0, 1.0), st.floats(0.0, 0.1))
+@settings(max_examples=300)
+def test_a_sure_point_lies_in_the_wedge_from_every_pose_within_the_doubt(r, offset, position_doubt, heading_doubt):
+    """Issue 37, item 4: where the sure ability is not 0, the point is in the wedge from every pose within the
+    doubt (poses on the doubt's rim, where it is tightest, every 15°), and there it is eq. 2 itself."""
+    sure = sure_sensing_ability(r, offset, R, F, ALPHA, (position_doubt, heading_doubt))
+    assert sure in (0.0, sensing_ability(r, offset, R, F, ALPHA))
+    if sure == 0.0:
+        return
+    point = np.array([r * math.cos(offset), r * math.sin(offset)])  # the believed pose at the origin, facing +x
+    for way in np.radians(np.arange(0.0, 360.0, 15.0)):
+        at = position_doubt * np.array([math.cos(way), math.sin(way)])
+        for turn in (-heading_doubt, heading_doubt):
+            seen = point - at
+            distance = float(np.hypot(*seen))
+            bearing = abs(math.remainder(math.atan2(seen[1], seen[0]) - turn, 2.0 * math.pi))
+            assert distance <= R + 1e-9
+            assert bearing <= F + 1e-9
+
+
+def test_the_wedge_is_shrunk_by_the_doubt_at_its_edges_only():
+    assert sure_sensing_ability(10.0, 0.1, R, F, ALPHA, (0.0, 0.0)) == sensing_ability(10.0, 0.1, R, F, ALPHA)
+    assert sure_sensing_ability(10.0, 0.1, R, F, ALPHA, (0.1, 0.03)) == sensing_ability(10.0, 0.1, R, F, ALPHA)
+    assert sure_sensing_ability(10.0, F - 0.02, R, F, ALPHA, (0.0, 0.03)) == 0.0  # the heading may put it outside
+    assert sure_sensing_ability(10.0, F - 0.02, R, F, ALPHA, (0.3, 0.0)) == 0.0  # asin(0.3 / 10) > 0.02
+    assert sure_sensing_ability(R - 0.05, 0.0, R, F, ALPHA, (0.1, 0.0)) == 0.0  # it may lie out of reach
+    assert sure_sensing_ability(0.05, 0.0, R, F, ALPHA, (0.1, 0.0)) == 0.0  # the robot may stand on it
+
+
+def test_a_doubted_pass_adds_a_subset_of_the_exact_ticks_and_nearly_all_of_them():
+    """The sure ticks are the exact ones on the shrunk wedge and 0 at its edges; with σ-sized doubts (0.05 and
+    2°, on R = 20 and F = 27°) they keep nearly all of the wedge's coverage."""
+    coverage = np.zeros((100, 100), dtype=np.int64)
+    *_, exact = sense_wedge(coverage, TARGET, 50.3, 50.6, 0.4, R, F, ALPHA, 0.1, 1.0, *OPEN)
+    *_, sure = sense_wedge(coverage, TARGET, 50.3, 50.6, 0.4, R, F, ALPHA, 0.1, 1.0, *OPEN, (0.05, math.radians(2)))
+    kept = sure > 0
+    assert (sure[kept] == exact[kept]).all()
+    assert 0 < kept.sum() < (exact > 0).sum()
+    assert 0.97 < sure.sum() / exact.sum() < 1.0
 
 
 def test_lack_of_coverage_eq4():

@@ -10,6 +10,7 @@ from model.controllers.registry import (
     check_supports,
     choices,
     controller_of,
+    law_of,
     law_parameters,
 )
 
@@ -23,5 +24,6 @@ __all__ = [
     "check_supports",
     "choices",
     "controller_of",
+    "law_of",
     "law_parameters",
 ]

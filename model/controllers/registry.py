@@ -32,6 +32,7 @@ from model.controllers.paper import PaperController, PaperEq16Controller, PaperL
 from model.controllers.zigzag import BoustrophedonController, ZigzagController
 from model.paper.coverage_map import CoverageMap
 from model.scenario import Scenario
+from model.scenario.physics_keys import sure_doubt_of
 from model.step import LawParameters
 
 BUILT_IN: dict[str, type[Controller]] = {
@@ -77,7 +78,18 @@ def controller_of(scenario: Scenario) -> Controller:
 def law_parameters(scenario: Scenario, coverage_map: CoverageMap) -> LawParameters:
     """The scenario's sensor and compiled law (:meth:`model.controllers.interface.Controller.law`), Λ* in the
     map's ticks."""
-    return controller_of(scenario).law(scenario, coverage_map.target_ticks)
+    return law_of(controller_of(scenario), scenario, coverage_map.target_ticks)
+
+
+def law_of(controller: Controller, scenario: Scenario, target_ticks: int) -> LawParameters:
+    """``controller``'s law (:meth:`model.controllers.interface.Controller.law`) with the doubt the scenario's
+    localiser leaves in a robot's pose (:func:`model.scenario.physics_keys.sure_doubt_of`): whatever steers, a
+    robot unsure of its pose puts on its map only the coverage it is sure it gave (issue 37, item 4)."""
+    law = controller.law(scenario, target_ticks)
+    position, heading = sure_doubt_of(scenario)
+    if position > 0.0 or heading > 0.0:
+        return law._replace(position_doubt=position, heading_doubt=heading)
+    return law
 
 
 def stations_programme(scenario: Scenario) -> Programme:

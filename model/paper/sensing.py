@@ -22,6 +22,34 @@ def sensing_ability(
 
 
 @njit(cache=True)
+def sure_sensing_ability(
+    distance: float,
+    bearing_offset: float,
+    sensing_range: float,
+    half_angle: float,
+    alpha_max: float,
+    doubt: tuple[float, float],
+) -> float:
+    """α_i of eq. 2 where the wedge holds the point from every pose within ``doubt`` (position, heading) of the
+    believed one, else 0: the wedge shrunk by the pose's doubt (issue
+    37, item 4). From a position δ off, the point lies at most δ farther, and its bearing turns by at most
+    asin(δ / r), the angle a disk of radius δ subtends at it. No doubt: eq. 2 itself.
+
+    Why the support and not the least α: a localiser's error is drawn afresh at every fix, and eq. 2 is linear
+    inside the wedge, so what a robot believes it gave a cell inside is, on average over the steps, what it gave;
+    only at the wedge's edges, where α is cut at 0, does the belief give on average more than the truth
+    (rooms, N = 4, the issue's noise: the least α over the doubt took +55 % time at one σ, +110 % at two)."""
+    position_doubt, heading_doubt = doubt
+    if position_doubt <= 0.0 and heading_doubt <= 0.0:
+        return sensing_ability(distance, bearing_offset, sensing_range, half_angle, alpha_max)
+    if distance <= position_doubt or distance + position_doubt > sensing_range:
+        return 0.0  # the robot may stand on the point or past it, or the point beyond its reach
+    if bearing_offset + heading_doubt + math.asin(position_doubt / distance) > half_angle:
+        return 0.0  # the point may lie outside the cone
+    return sensing_ability(distance, bearing_offset, sensing_range, half_angle, alpha_max)
+
+
+@njit(cache=True)
 def lack_of_coverage(coverage_ticks: int, target_ticks: int) -> float:
     """Lack of coverage Υ = max(0, 1 − Λ/Λ*), eq. 4, from fixed-point ticks."""
     if coverage_ticks >= target_ticks:

@@ -3,8 +3,8 @@
 
 :class:`PhysicalTeam` holds the MuJoCo world (:class:`model.physics.world.PhysicsWorld`), the commands in
 flight to the wheels (``command_latency``, :class:`model.physics.noise.CommandDelay`), and the coverage the
-cameras really gave: by the same sensor rule as the team's map, from the true poses, on a map of its own at
-Λ* (the team's own map may ask more: ``cover_margin``). What a robot believes of its pose is not here: the
+cameras really gave: by eq. 2 from the true poses, on a map of its own at Λ* (the team's own map may ask more,
+``cover_margin``, and take less, ``sure_sigmas``). What a robot believes of its pose is not here: the
 engine keeps :class:`model.physics.noise.Belief`, the simulator publishes odometry and fixes.
 """
 
@@ -36,8 +36,9 @@ class PhysicalTeam:
         """The cameras sense from the true poses of t_k (unless ``sense`` is False: the run is over), the wheels
         take the commands due, the world steps; the true poses (N, 3) of t_{k+1}."""
         positions = self.truth[:, :2].copy()
+        exact = law._replace(position_doubt=0.0, heading_doubt=0.0)  # the truth's camera is where it is
         for i, (x, y, theta) in enumerate(self.truth if sense else ()):
-            self.true_map.add(*sense_only(self.true_map.coverage, x, y, theta, law, ground, positions, i))
+            self.true_map.add(*sense_only(self.true_map.coverage, x, y, theta, exact, ground, positions, i))
         self.truth = self.world.step(self.delay(commands))
         self.true_poses.append(self.truth.copy())
         return self.truth

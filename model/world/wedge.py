@@ -29,7 +29,7 @@ from numba import njit
 
 from model.paper.fixed_point import COVERAGE_SCALE
 from model.paper.geometry import wedge_cell_range
-from model.paper.sensing import lack_of_coverage, offset_from_heading, sensing_ability, wedge_reach
+from model.paper.sensing import lack_of_coverage, offset_from_heading, sure_sensing_ability, wedge_reach
 from model.world.ground import Ground
 from model.world.occlusion import add_teammate_shadows, pseudo_bin, teammates_in_view, wall_shadows
 from model.world.visibility import hidden_by_teammates, segment_crosses_occupied
@@ -63,13 +63,16 @@ def sense_wedge(
     ground: Ground,
     positions: np.ndarray,
     me: int,
+    doubt: tuple[float, float] = (0.0, 0.0),
 ) -> tuple[float, float, float, int, int, np.ndarray]:
     """One pass over the wedge Ω_i (see the module): (e_Ω, w_left, w_right, row0, col0, ticks of eq. 3).
-    ``positions`` (N, 2): every robot's (NaN: unknown; ``me``: this one), read only with occlusion."""
+    ``positions`` (N, 2): every robot's (NaN: unknown; ``me``: this one), read only with occlusion; ``doubt``
+    (position, heading): the ticks are the sure ones (:func:`model.paper.sensing.sure_sensing_ability`)."""
     teammates = teammates_in_view(ground, positions, me, x, y, sensing_range)
     return sense_wedge_among(
-        coverage, target_ticks, x, y, theta, sensing_range, half_angle, alpha_max, dt, cell, ground, teammates
-    )
+        coverage, target_ticks, x, y, theta, sensing_range, half_angle, alpha_max, dt, cell, ground, teammates,
+        doubt,
+    )  # fmt: skip
 
 
 @njit(cache=True)
@@ -86,6 +89,7 @@ def sense_wedge_among(
     cell: float,
     ground: Ground,
     teammates: np.ndarray,
+    doubt: tuple[float, float] = (0.0, 0.0),
 ) -> tuple[float, float, float, int, int, np.ndarray]:
     """:func:`sense_wedge` with the teammates that may hide part of the wedge already found
     (:func:`model.world.occlusion.teammates_in_view`), for a caller that needs them too."""
@@ -95,7 +99,7 @@ def sense_wedge_among(
     shadows = wall_shadows(ground, x, y, theta, half_angle, sensing_range, cell, row0, row1, col0, col1)
     add_teammate_shadows(shadows, teammates, ground.radius, x, y, theta, half_angle)
     cells_in_wedge, lack_sum, w_left, w_right = _sweep(
-        coverage, target_ticks, (x, y, theta), (sensing_range, half_angle, alpha_max, dt, cell), ground, teammates,
+        coverage, target_ticks, (x, y, theta), (sensing_range, half_angle, alpha_max, dt, cell, doubt), ground, teammates,
         shadows, ticks, (row0, row1, col0, col1), (clip_row0, clip_col0),
     )  # fmt: skip
     e_omega = lack_sum / cells_in_wedge if cells_in_wedge > 0 else 0.0
@@ -107,7 +111,7 @@ def _sweep(
     coverage: np.ndarray,
     target_ticks: int,
     pose: tuple[float, float, float],
-    sensor: tuple[float, float, float, float, float],
+    sensor: tuple[float, float, float, float, float, tuple[float, float]],
     ground: Ground,
     teammates: np.ndarray,
     shadows: np.ndarray,
@@ -115,9 +119,9 @@ def _sweep(
     window: tuple[int, int, int, int],
     clip: tuple[int, int],
 ) -> tuple[int, float, float, float]:
-    """:func:`sense_wedge`'s pass over ``window`` (row0, row1, col0, col1) from ``pose`` with ``sensor`` (R, F,
-    α_M, dt, cell): writes ``ticks`` (top-left cell ``clip``); (cells in the wedge, Σ lack, w_left, w_right)."""
-    (x, y, theta), (sensing_range, half_angle, alpha_max, dt, cell) = pose, sensor
+    """:func:`sense_wedge`'s pass over ``window`` (row0, row1, col0, col1) from ``pose`` with ``sensor`` (R, F, α_M,
+    dt, cell, doubt): writes ``ticks`` (top-left cell ``clip``); (cells in the wedge, Σ lack, w_left, w_right)."""
+    (x, y, theta), (sensing_range, half_angle, alpha_max, dt, cell, doubt) = pose, sensor
     (rows, cols), (row0, row1, col0, col1), (clip_row0, clip_col0) = coverage.shape, window, clip
     heading_x, heading_y, cos_half_angle = math.cos(theta), math.sin(theta), math.cos(half_angle)
     tick_scale, area_weight = dt * COVERAGE_SCALE, cell * cell / (sensing_range * half_angle)
@@ -152,7 +156,7 @@ def _sweep(
             cells_in_wedge += 1
             if not on_grid:
                 continue
-            ability = sensing_ability(distance, offset, sensing_range, half_angle, alpha_max)
+            ability = sure_sensing_ability(distance, offset, sensing_range, half_angle, alpha_max, doubt)
             ticks[row - clip_row0, col - clip_col0] = int(ability * tick_scale + 0.5)
             lack = lack_of_coverage(coverage[row, col], target_ticks)
             if lack > 0.0:

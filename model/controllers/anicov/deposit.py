@@ -17,6 +17,7 @@ from scipy.sparse import csc_matrix
 
 from model.paper.coverage_map import CoverageMap, add_window
 from model.scenario import Scenario
+from model.scenario.physics_keys import sure_doubt_of
 from model.world.ground import Ground, open_ground
 from model.world.wedge import sense_wedge_among
 
@@ -55,13 +56,14 @@ class Deposit:
         self.target_ticks = CoverageMap(*self.shape, scenario.cell, scenario.lambda_star).target_ticks
         self.ground, self.nobody = open_ground() if ground is None else ground, np.zeros((0, 2))
         self.blank = np.zeros(self.shape, dtype=np.int64)  # the map the sensor reads Υ from (not written)
+        self.doubt = sure_doubt_of(scenario)  # a robot unsure of its pose counts only what it surely sees
 
     def window(self, x: float, y: float, theta: float) -> tuple[int, int, np.ndarray]:
         """(row0, col0, ticks) one step of the sensor adds from this pose."""
         scenario = self.scenario
         _, _, _, row0, col0, window = sense_wedge_among(
             self.blank, 1 << 62, x, y, theta, scenario.range, scenario.half_angle,
-            scenario.alpha_max, scenario.dt, scenario.cell, self.ground, self.nobody,
+            scenario.alpha_max, scenario.dt, scenario.cell, self.ground, self.nobody, self.doubt,
         )  # fmt: skip
         return row0, col0, window
 

@@ -163,7 +163,7 @@ def _fly(
         v, omega = pursue(x, y, theta, carrot_x, carrot_y, law)
         _, _, _, row0, col0, window = sense_wedge_among(
             ticks, law.target_ticks, x, y, theta, law.sensing_range, law.half_angle, law.alpha_max, law.dt,
-            law.cell, ground, nobody,
+            law.cell, ground, nobody, (law.position_doubt, law.heading_doubt),
         )  # fmt: skip
         add_window(ticks, row0, col0, window, law.target_ticks)
         x, y, theta = unicycle_step(x, y, theta, v, omega, law.dt)
