@@ -13,7 +13,7 @@ from model.paper.coverage_map import CoverageMap
 from model.radio.exact_coverage import ExactKernel, exact_kernel
 from model.safety.safety import SafetyParameters, disabled_safety
 from model.scenario import Scenario
-from model.scenario.physics_keys import cover_margin_of
+from model.scenario.physics_keys import cover_margin_of, pair_margin_of, safety_margin_of
 from model.scenario.safety_keys import point_speed
 from model.world.clearance import disk_is_free
 from model.world.world import map_frame_of, world_of
@@ -146,8 +146,8 @@ def starting_poses(scenario: Scenario) -> np.ndarray:
     if (
         scenario.filters
     ):  # every barrier holds at t_0 (model.safety.safety): points 2r + s + 2l apart, disks s off walls
-        clearance = max(clearance, scenario.safety_margin)
-        spacing = max(spacing, scenario.safety_margin + 4.0 * scenario.lookahead)
+        clearance = max(clearance, safety_margin_of(scenario))
+        spacing = max(spacing, pair_margin_of(scenario) + 4.0 * scenario.lookahead)
     return free_initial_poses(
         world.wall_grid,
         world.grain,
@@ -171,7 +171,7 @@ def safety_parameters(scenario: Scenario) -> SafetyParameters:
     return SafetyParameters(
         enabled=True,
         radius=scenario.robot_radius,
-        margin=scenario.safety_margin,
+        margin=safety_margin_of(scenario),
         lookahead=scenario.lookahead,
         decay=min(1.0, scenario.barrier_gain * scenario.dt),
         reach=scenario.safety_range,
@@ -181,4 +181,5 @@ def safety_parameters(scenario: Scenario) -> SafetyParameters:
         point_speed=fastest,
         slack=fastest * omega_max * scenario.dt**2 / 2.0,
         max_pose_age=scenario.max_pose_age,
+        pair_margin=pair_margin_of(scenario),
     )

@@ -4,8 +4,10 @@ import math
 
 import pytest
 
+from model.parameters import safety_parameters
 from model.scenario import ScenarioError, validate
-from model.scenario.physics_keys import cover_margin_of, sure_doubt_of
+from model.scenario.physics_keys import clearance_reserve_of, cover_margin_of, safety_margin_of, sure_doubt_of
+from model.world.world import wall_clearance_of
 
 BODY = {"robot_radius": 0.3}
 
@@ -52,3 +54,21 @@ def test_the_sure_rule_doubts_the_pose_by_sure_sigmas_times_the_localiser_sigma(
     assert sure_doubt_of(only_rule) == (0.0, 0.0) and cover_margin_of(only_rule) == 0.0  # a rule is not noise
     with pytest.raises(ScenarioError, match=r"noise\.sure_sigmas': expected a non-negative number"):
         validate({**BODY, "physics": "mujoco", "noise": {"sure_sigmas": -1}})
+
+
+def test_the_clearance_reserve_takes_the_pose_error_the_late_command_and_the_braking():
+    """Issue 37, item 5: 3 σ + k_v × command_latency + k_v² / 2a beyond safety_margin, for the filter, the
+    ground and the planner alike; 0 for kinematic robots; the [noise] table's clearance_reserve if given."""
+    assert clearance_reserve_of(validate(BODY)) == 0.0 and safety_margin_of(validate(BODY)) == 0.2
+    still = validate({**BODY, "k_v": 2.0, "physics": "mujoco", "robot": {"acceleration": 8.0}})
+    assert clearance_reserve_of(still) == pytest.approx(2.0**2 / (2.0 * 8.0))
+    noisy = validate({
+        **BODY, "physics": "mujoco", "noise": {"localiser_sigma": 0.05, "command_latency": 0.1, "cover_margin": 0.3},
+    })  # fmt: skip
+    reserve = 3 * 0.05 + 1.0 * 0.1 + 1.0 / (2.0 * 11.0)  # k_v 1, the Burger's acceleration 11 k_v
+    assert clearance_reserve_of(noisy) == pytest.approx(reserve)
+    assert safety_parameters(noisy).margin == pytest.approx(0.2 + reserve)
+    assert safety_parameters(noisy).pair_margin == pytest.approx(0.2 + 2.0 * reserve)  # each robot brings its own
+    assert wall_clearance_of(noisy) == pytest.approx(0.3 + 0.2 + reserve)
+    given = validate({**BODY, "physics": "mujoco", "noise": {"localiser_sigma": 0.05, "clearance_reserve": 0}})
+    assert safety_margin_of(given) == 0.2 and cover_margin_of(given) > 0.0  # a rule, the noise still noise

@@ -10,13 +10,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from model.scenario import Scenario
+from model.scenario.physics_keys import BURGER_ACCELERATION
 
 BURGER_WHEEL_RADIUS = 0.31
 """Wheel radius over body radius: 0.033 / 0.105."""
 BURGER_WHEEL_SEPARATION = 1.52
 """Wheel separation (centre to centre) over body radius: 0.160 / 0.105."""
-BURGER_ACCELERATION = 11.0
-"""The base's most acceleration over its top speed k_v, per time unit: 2.5 m/s² / 0.22 m/s."""
 
 
 @dataclass(frozen=True)

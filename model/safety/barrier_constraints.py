@@ -34,11 +34,12 @@ class SafetyParameters(NamedTuple):
     point_speed: float  # u_max = sqrt(k_v² + (l·ω_max)²): the fastest a look-ahead point moves
     slack: float  # ε = u_max·ω_max·dt²/2
     max_pose_age: float  # a teammate's pose older than this, in range: stop
+    pair_margin: float  # s between two robots: s and each one's clearance reserve (model.scenario.physics_keys)
 
 
 def disabled_safety() -> SafetyParameters:
     """No filter: the paper's robots (and any run with point robots or ``safety = false``)."""
-    return SafetyParameters(False, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0, math.inf)
+    return SafetyParameters(False, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0, math.inf, 0.0)
 
 
 @njit(cache=True)
@@ -78,7 +79,7 @@ def _teammates(gx, gy, c, count, px, py, theta, me, poses, ages, kinds, safety):
             nx, ny = dx / distance, dy / distance
         else:  # one point on the other: back off
             nx, ny = -math.cos(theta), -math.sin(theta)
-        clearance = 2.0 * safety.radius + safety.margin + 2.0 * ahead + spread
+        clearance = 2.0 * safety.radius + safety.pair_margin + 2.0 * ahead + spread
         share = 0.5 if kinds[j] == TEAMMATE else 1.0
         count = _add(gx, gy, c, count, nx, ny, theta, _pair_bound(distance, clearance, share, safety))
     return count, stale

@@ -26,6 +26,7 @@ from typing import Any
 
 from model.scenario.map_file import load_map
 from model.scenario.map_fit import MapFrame, fit_to_cells
+from model.scenario.physics_keys import pair_margin_of
 
 SAFETY_DEFAULTS: dict[str, Any] = {
     "safety": True,
@@ -121,7 +122,7 @@ def check_safety(scenario: Any) -> None:
     point_speed = math.hypot(scenario.k_v, scenario.lookahead * math.pi * scenario.k_omega)
     least = least_safety_range(
         scenario.robot_radius,
-        scenario.safety_margin,
+        pair_margin_of(scenario),
         scenario.lookahead,
         point_speed,
         scenario.dt,
@@ -130,5 +131,6 @@ def check_safety(scenario: Any) -> None:
     if scenario.safety_range < least:
         raise SafetyKeyError(
             f"scenario key 'safety_range': expected at least {least:.3f} (2r + s + 4l + u_max·(2·dt + max_pose_age)) "
-            f"for robot_radius {scenario.robot_radius}, got {scenario.safety_range}"
+            f"for robot_radius {scenario.robot_radius} and s {pair_margin_of(scenario):.3f} (safety_margin plus two "
+            f"robots' clearance reserves, with physics), got {scenario.safety_range}"
         )

@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from model.scenario import Scenario
+from model.scenario.physics_keys import pair_margin_of
 from model.world.ground import PLANNING_MARGIN
 from model.world.world import World
 
@@ -33,7 +34,7 @@ def team_spacing(scenario: Scenario) -> float:
         return 0.0
     clearance = 2.0 * scenario.robot_radius
     if scenario.filters:
-        clearance += scenario.safety_margin + 2.0 * scenario.lookahead
+        clearance += pair_margin_of(scenario) + 2.0 * scenario.lookahead
     return clearance + scenario.cell + PLANNING_MARGIN * scenario.cell
 
 

@@ -41,6 +41,7 @@ from model.paper.fixed_point import COVERAGE_SCALE
 from model.scenario import Scenario
 from model.scenario.map_file import load_map
 from model.scenario.map_fit import FittedMap, MapFrame, fit_to_cells
+from model.scenario.physics_keys import safety_margin_of
 from model.scenario.terrain import (
     OccupancyMap,
     TerrainError,
@@ -196,7 +197,7 @@ def plan_radius_of(scenario: Scenario, fine_walls: bool = False) -> float:
 
 def wall_clearance_of(scenario: Scenario) -> float:
     """How near a wall the robot's centre comes: r, plus the safety margin when the filter is on."""
-    return scenario.robot_radius + (scenario.safety_margin if scenario.filters else 0.0)
+    return scenario.robot_radius + (safety_margin_of(scenario) if scenario.filters else 0.0)
 
 
 def team_space(passable: np.ndarray, cell: float, graph: csr_matrix | None = None) -> np.ndarray:

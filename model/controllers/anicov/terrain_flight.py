@@ -35,6 +35,7 @@ from model.controllers.anicov.terrain_lanes import free_path, piece_route
 from model.controllers.anicov.terrain_relief import aside, in_the_way, relief
 from model.controllers.anicov.terrain_stations import ANGLES
 from model.scenario import Scenario
+from model.scenario.physics_keys import pair_margin_of
 from model.world.world import world_of
 
 CLEANUP_RETRY = 4
@@ -84,7 +85,7 @@ class TerrainFlight:
         """A robot with nothing to do that stands in a busy teammate's way to its next stop steps aside
         (:func:`terrain_relief.aside`); it stays idle."""
         scenario = self.scenario
-        gap = 2.0 * (2.0 * scenario.robot_radius + scenario.safety_margin) + scenario.lookahead
+        gap = 2.0 * (2.0 * scenario.robot_radius + pair_margin_of(scenario)) + scenario.lookahead
         busy = [routes[agent] for agent in ids if agent not in self.idle and not routes[agent].done()]
         for index, agent in enumerate(ids):
             if agent not in self.idle or not routes[agent].done() or not busy:
