@@ -230,6 +230,7 @@ def test_a_plug_in_that_fails_mid_run_is_reported_with_its_name_and_the_team_car
     assert processes_of(team) == []
 
 
+@pytest.mark.slow  # 52 s; the map team of test_a_team_on_a_map_equals_the_engine... stays in the default suite
 def test_a_team_on_a_map_saved_with_an_unknown_border_equals_the_engine_in_the_maps_frame(tmp_path):
     """A map_saver-like map (tests/test_map_fit.py: 286 × 423 pixels of 0.05 m, origin not (0, 0), a room in a
     wide unknown border) at a TurtleBot3 Burger's units: cropped and padded alike in every process, its

@@ -40,7 +40,7 @@ ROOMS = {
 
 @pytest.mark.parametrize(
     "values",
-    [{"domain": [40.0, 40.0], "agents": 4, "seed": 3}, ROOMS],
+    [pytest.param({"domain": [40.0, 40.0], "agents": 4, "seed": 3}, marks=pytest.mark.slow), ROOMS],
     ids=["paper-law", "anicov-among-walls"],
 )
 def test_lockstep_local_planning_equals_the_engine(tmp_path, values):
@@ -86,6 +86,7 @@ def test_realtime_limited_range_with_local_planning_completes_and_ends_with_one_
     assert processes_of(team) == []
 
 
+@pytest.mark.slow  # 30 s alone, 87 s and a replica short of the coordinator's map on the loaded suite (2026-12-07)
 def test_realtime_local_planning_with_anicov_among_walls_on_a_limited_radio_completes_with_one_map(tmp_path):
     """Issue 36, item 3: anicov among walls in realtime, every robot planning on its own replica (the routes cut
     alike from the start poses, carrots every half time unit), robots with bodies hearing each other within 6
