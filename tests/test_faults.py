@@ -285,6 +285,7 @@ def fuzz_a_running_team(tmp_path, domain: list[float], payloads: int) -> None:
     )
 
 
+@pytest.mark.slow  # 47 s of the default suite's 10 minutes (2026-12-07: 10 min 33 s without moving it)
 def test_a_late_logger_catches_up_from_the_snapshot_and_records_the_full_final_map(tmp_path):
     from anicov.engine import run_scenario
     from logger.replay import summarise_recording
@@ -469,7 +470,7 @@ def test_a_dead_agents_lost_deltas_come_from_its_teammates_relays(tmp_path):
     [
         ("lockstep", False),
         pytest.param("realtime", False, marks=pytest.mark.slow),  # 60 s of the default suite's 10 minutes
-        ("lockstep", True),
+        pytest.param("lockstep", True, marks=pytest.mark.slow),  # 25 s; lockstep alone stays
     ],
     ids=["lockstep", "realtime", "lockstep-after-an-agent-died"],
 )

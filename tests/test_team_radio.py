@@ -124,6 +124,7 @@ def assert_bandwidth_is_reported(out, stdout, counts):
     assert bandwidth["bytes_out_per_wall_second"] > 0 and "bus this run" in stdout
 
 
+@pytest.mark.slow  # 32 s; a team with no coordinator at all (below) stays in the default suite
 def test_local_planning_finishes_the_run_after_the_coordinator_is_killed(tmp_path):
     """Realtime, local planning: the coordinator is SIGKILLed at step 600 (3 s into the run, of some 1,000
     steps) and not restarted; the robots plan for themselves, end when their replicas are complete, and the
