@@ -31,9 +31,9 @@ def sure_sensing_ability(
     doubt: tuple[float, float],
 ) -> float:
     """α_i of eq. 2 where the wedge holds the point from every pose within ``doubt`` (position, heading) of the
-    believed one, else 0: the wedge shrunk by the pose's doubt (issue
-    37, item 4). From a position δ off, the point lies at most δ farther, and its bearing turns by at most
-    asin(δ / r), the angle a disk of radius δ subtends at it. No doubt: eq. 2 itself.
+    believed one, else 0: the wedge shrunk by the pose's doubt (issue 37, item 4). From a position δ off, the
+    point lies at most δ farther, and its bearing turns by at most asin(δ / r), the angle a disk of radius δ
+    subtends at it. No doubt: eq. 2 itself.
 
     Why the support and not the least α: a localiser's error is drawn afresh at every fix, and eq. 2 is linear
     inside the wedge, so what a robot believes it gave a cell inside is, on average over the steps, what it gave;

@@ -69,8 +69,8 @@ its objective's cell never surely sees it); at 1 σ both left runs short."""
 def sure_doubt_of(scenario: Any) -> tuple[float, float]:
     """(position, heading in radians) a robot's map doubts its pose by: ``sure_sigmas`` times the localiser's σ
     in each (:data:`SURE_SIGMAS` by default); (0, 0) where neither σ is set. The doubt is the fix's alone: the
-    odometry's drift between fixes is not in it. The map then takes only the
-    coverage the camera gave from every pose within them (:func:`model.paper.sensing.sure_sensing_ability`)."""
+    odometry's drift between fixes is not in it. The map then takes only the coverage the camera gave from every
+    pose within them (:func:`model.paper.sensing.sure_sensing_ability`)."""
     given = dict(scenario.noise)
     sigmas = given.get("sure_sigmas", SURE_SIGMAS)
     return sigmas * given.get("localiser_sigma", 0.0), sigmas * math.radians(given.get("localiser_heading_deg", 0.0))
@@ -101,8 +101,8 @@ def clearance_reserve_of(scenario: Any) -> float:
 def safety_margin_of(scenario: Any) -> float:
     """The margin s the safety filter, the ground's clearances and the planner keep off walls, alike:
     ``safety_margin`` plus the clearance reserve (:func:`clearance_reserve_of`); between robots
-    :func:`pair_margin_of`. Kept in one place, as a wider filter alone held
-    anicov's robots short of stations placed with the narrower margin (3 runs of 10 in the two rooms)."""
+    :func:`pair_margin_of`. Kept in one place, as a wider filter alone held anicov's robots short of stations
+    placed with the narrower margin (3 runs of 10 in the two rooms)."""
     return scenario.safety_margin + clearance_reserve_of(scenario)
 
 

@@ -87,20 +87,26 @@ def coverable_cells(
     return _seen_from(occupied, wall_grid, grain, reachable, sensing_range, cell)
 
 
+def in_reachable_cell(reachable: np.ndarray, x: float, y: float, cell: float) -> bool:
+    """Whether (x, y) lies in a reachable cell, its cell as the free paths find it: floor(x / cell), which differs
+    from x // cell on a cell's edge (10.0 // 0.2 is 49, floor(10.0 / 0.2) is 50); off the grid it does not."""
+    row, col = math.floor(y / cell), math.floor(x / cell)
+    rows, cols = reachable.shape
+    return 0 <= row < rows and 0 <= col < cols and bool(reachable[row, col])
+
+
 def nearest_reachable(reachable: np.ndarray, points: np.ndarray, cell: float) -> np.ndarray:
     """Each point (K, 2) moved to the centre of the nearest reachable cell, unless its own cell is
     reachable (then it stays as it is). A point off the grid has no cell of its own: it is moved (a robot of
     an unbounded map may stand past its edge; clamped into the grid's edge cell, it stayed where no free path
-    starts). Its cell is floor(x / cell), as the free paths find it."""
-    rows, cols = reachable.shape
+    starts). Its cell is floor(x / cell), as the free paths find it (:func:`in_reachable_cell`)."""
     cells = np.argwhere(reachable)
     if len(cells) == 0:
         raise ValueError("no reachable cell: nowhere to send the robots")
     centres = (cells[:, ::-1] + 0.5) * cell  # (x, y) of each reachable cell
     moved = np.array(points, dtype=np.float64, copy=True).reshape(-1, 2)
     for k, (x, y) in enumerate(moved):
-        row, col = math.floor(y / cell), math.floor(x / cell)
-        if not (0 <= row < rows and 0 <= col < cols and reachable[row, col]):
+        if not in_reachable_cell(reachable, x, y, cell):
             moved[k] = centres[int(np.argmin(np.hypot(centres[:, 0] - x, centres[:, 1] - y)))]
     return moved
 

@@ -37,6 +37,7 @@ from model.controllers.anicov.terrain_stations import ANGLES
 from model.planning import path_lengths
 from model.scenario import Scenario
 from model.world.geodesic import in_sight
+from model.world.reachability import in_reachable_cell
 from model.world.world import World
 
 CLEANUP_DEMAND = 1.1
@@ -258,7 +259,7 @@ def _sure_seer(
     for seer in seers[:SEERS_TRIED]:
         for way in ways:
             station = seer + SHIFT_SPREADS * face_radius_of(scenario) * way
-            if not _reachable(world, station):
+            if not in_reachable_cell(world.reachable, *station, scenario.cell):
                 continue  # a wide face radius (a noisy localiser's) shifts it off the team's space: no path goes there
             if not in_sight(ground.wall_grid, *seer, *station, ground.grain, ground.plan_radius, ground.bounded):
                 continue  # the disk with its clearance does not fit there: the filter would hold it short
@@ -266,16 +267,6 @@ def _sure_seer(
             if stares[flat].sum() > 0.0:
                 return station, stares
     return None
-
-
-def _reachable(world: World, point: np.ndarray) -> bool:
-    """Whether ``point`` lies in a cell of the team's space (:attr:`World.reachable`), where free paths go; its cell
-    as the free paths find it (:func:`model.controllers.anicov.terrain_routes.hop_path`: x / cell floored, which
-    differs from x // cell on a cell's edge: 10.0 // 0.2 is 49, floor(10.0 / 0.2) is 50)."""
-    cell = world.scenario.cell
-    row, col = math.floor(point[1] / cell), math.floor(point[0] / cell)
-    rows, cols = world.reachable.shape
-    return 0 <= row < rows and 0 <= col < cols and bool(world.reachable[row, col])
 
 
 def cell_of(point: np.ndarray, cell: float) -> tuple[int, int]:

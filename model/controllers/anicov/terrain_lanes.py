@@ -20,7 +20,7 @@ from model.controllers.anicov.route import CARROT_PERIOD, Stop
 from model.controllers.anicov.terrain_plan import TourPlan, tour_line, tour_of, tour_plan, tour_shares
 from model.controllers.anicov.terrain_routes import hop_path
 from model.scenario import Scenario
-from model.world.reachability import nearest_reachable
+from model.world.reachability import in_reachable_cell, nearest_reachable
 from model.world.world import World, world_of
 
 CORNER_TURN = math.radians(30.0)
@@ -110,9 +110,7 @@ def free_path(world: World, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     """The free path's points from ``start`` (anywhere a robot stands) to ``goal`` (a reachable cell's centre,
     or a point on a free path): from the reachable cell nearest the start where its own is not."""
     cell = world.scenario.cell
-    row, col = math.floor(start[1] / cell), math.floor(start[0] / cell)
-    rows, cols = world.reachable.shape
-    inside = 0 <= row < rows and 0 <= col < cols and world.reachable[row, col]
+    inside = in_reachable_cell(world.reachable, start[0], start[1], cell)
     begin = (
         np.asarray(start, dtype=np.float64) if inside else nearest_reachable(world.reachable, start[None, :], cell)[0]
     )
