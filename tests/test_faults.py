@@ -67,7 +67,8 @@ def log_time(line: str) -> float:
 
 KILL_STEP = 800
 """Where the fault tests kill a process: a quarter into the half-area runs (3,070 steps in lockstep; at
-speed 40, 400 steps a second, 2 s into 7.7 s), more than half into the anicov controller's 60 x 60 run."""
+speed 40, 400 steps a second, 2 s into 7.7 s), more than half into the anicov controller's 60 x 60 run and
+into the lockstep coordinator's quarter-area run (1,427 steps)."""
 
 
 @pytest.mark.parametrize("clock", ["lockstep", "realtime"])
@@ -339,17 +340,19 @@ def test_a_restarted_agent_resumes_from_the_snapshot_and_replicas_converge(tmp_p
     out = tmp_path / "run"
     # The new process is started before the kill and parked, its imports done, until the coordinator has
     # seen agent 1 leave: it joins in the time its session, snapshot and hello take (under a second), far
-    # inside the run's remaining 5,800 steps, however busy the machine (a fresh process's start took 13 -
-    # 17 s on this 2-core VM under load, and once, on a fresh clone's CI run, outlasted the whole run).
+    # inside the run's remaining 2,000 steps (half the paper's area), however busy the machine (a fresh
+    # process's start took 13 - 17 s on this 2-core VM under load, and once, on a fresh clone's CI run,
+    # outlasted the whole run).
+    square = write_scenario(tmp_path / "s.toml", domain=[70.0, 70.0], agents=4, seed=0)
     speed = ("--speed", "25") if clock == "realtime" else ()
     agent_again = [
-        "agent", "--team", team, "--id", "1", "--n", "4", "--seed", "0", "--clock", clock, *speed,
+        "agent", "--team", team, "--id", "1", "--config", str(square), "--clock", clock, *speed,
         "--connect", f"tcp/127.0.0.1:{port}", "--counts", str(tmp_path / "restarted.json"),
     ]  # fmt: skip
     logs = out / "logs"
     with (
         launched_team(
-            "--n", "4", "--seed", "0", "--clock", clock, *speed, "--out", str(out), team=team, port=port
+            "--config", str(square), "--clock", clock, *speed, "--out", str(out), team=team, port=port
         ) as process,
         run_progress(port, team) as progress,
         parked(agent_again, AGENT_PRELOAD, tmp_path, "restarted") as restarted,
@@ -486,8 +489,8 @@ def test_a_killed_coordinator_is_restarted_and_resumes_from_the_agents_histories
     if clock == "realtime":
         anicov_square = write_scenario(tmp_path / "s.toml", domain=[60.0, 60.0], agents=4, seed=0, controller="anicov")
         extra = ["--config", str(anicov_square), "--speed", "40"]
-    else:  # half the paper's area: the run still lasts well past the kill
-        square = write_scenario(tmp_path / "s.toml", domain=[70.0, 70.0], agents=4, seed=0)
+    else:  # a quarter of the paper's area (1,427 steps): a lockstep team waits while its coordinator is away
+        square = write_scenario(tmp_path / "s.toml", domain=[50.0, 50.0], agents=4, seed=0)
         extra = ["--config", str(square)]
     logs = out / "logs"
     with (
