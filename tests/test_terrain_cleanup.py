@@ -1,4 +1,4 @@
-"""model.controllers.anicov.terrain_cleanup: what the stops still ahead will stare at is not cleaned up again,
+"""model.controllers.anicov.terrain_cleanup: what the stops and legs still ahead will see is not cleaned up again,
 the cleanup's stations surely bring every short cell to its need, a cell seen only past a wall's corner gets
 a station that sees it from wherever a robot stands there, a patch finishes what a station leaves, and the
 pieces give each station to one robot."""
@@ -35,18 +35,24 @@ def short_spots(cells: list[tuple[int, int]], value: float = 0.6) -> np.ndarray:
     return lack
 
 
-def test_the_stops_still_ahead_are_taken_off_what_is_left_to_clean_up():
+def test_the_stops_and_legs_still_ahead_are_taken_off_what_is_left_to_clean_up():
     deposit = deposit_of(ROOMS)
     lack = np.full(ROOMS.grid_shape, 0.5) * world_of(ROOMS).coverable
-    route = Route.of(np.array([[3.5, 8.5], [6.5, 8.5]]), stops=[Stop(3.0, [0.0, 0.0])])
+    route = Route.of(np.array([[3.5, 8.5], [6.5, 8.5], [6.5, 4.5]]), stops=[Stop(3.0, [0.0, 0.0])])
+    route.progress = 1.0  # a third of the first leg flown
     left = residual_lack(deposit, lack, [route])
+    expected = np.zeros(lack.size)
     flat, added = deposit.stare_cells(6.5, 8.5, 0.0)
-    expected = np.maximum(lack.ravel()[flat] - 2.0 * added, 0.0)
-    assert left.ravel()[flat] == pytest.approx(expected)
-    untouched = np.setdiff1d(np.arange(lack.size), flat)
-    assert np.array_equal(left.ravel()[untouched], lack.ravel()[untouched])
+    expected[flat] += 2.0 * added
+    expected += deposit.path(np.array([[4.5, 8.5], [6.5, 8.5], [6.5, 4.5]]))  # the legs from where it has come
+    assert left.ravel() == pytest.approx(np.maximum(lack.ravel() - expected, 0.0))
+    untouched = np.flatnonzero(expected == 0.0)
+    assert len(untouched) and np.array_equal(left.ravel()[untouched], lack.ravel()[untouched])
     far = residual_lack(deposit, lack, [route], (np.array([22.5, 2.5]), 2.0 * ROOMS.range))
-    assert np.array_equal(far, lack)  # the stop is farther than 2 R: not counted there
+    assert np.array_equal(far, lack)  # the stop and both legs are farther than 2 R: not counted there
+    near = residual_lack(deposit, lack, [route], (np.array([6.5, 0.5]), 4.5))  # only the second leg passes within
+    alone = np.maximum(lack.ravel() - deposit.path(np.array([[6.5, 8.5], [6.5, 4.5]])), 0.0)
+    assert near.ravel() == pytest.approx(alone)
 
 
 def test_the_cleanup_s_stations_surely_bring_every_short_cell_to_its_need():

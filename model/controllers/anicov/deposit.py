@@ -1,5 +1,6 @@
 """What a camera adds to the coverage map (eq. 2-3) from poses the planner chooses: a stare from a station, a
-straight hop between stations; :mod:`model.controllers.anicov.stations`' linear programme is built from them.
+straight hop between stations, a leg of a route; the stations' linear programmes
+(:mod:`model.controllers.anicov.stations`, :mod:`model.controllers.anicov.terrain_plan`) are built from them.
 
 Beyond the paper (docs/controller.md). Each is one step of the engine's own sensor
 (:func:`model.world.wedge.sense_wedge_among`, in the open world or past the walls of a given ground), so that
@@ -20,6 +21,9 @@ from model.scenario import Scenario
 from model.scenario.physics_keys import sure_doubt_of
 from model.world.ground import Ground, open_ground
 from model.world.wedge import sense_wedge_among
+
+LEGS_KEPT = 4096
+"""The legs :meth:`Deposit.leg_cells` keeps (the oldest goes first)."""
 
 
 @njit(cache=True)
@@ -57,6 +61,7 @@ class Deposit:
         self.ground, self.nobody = open_ground() if ground is None else ground, np.zeros((0, 2))
         self.blank = np.zeros(self.shape, dtype=np.int64)  # the map the sensor reads Υ from (not written)
         self.doubt = sure_doubt_of(scenario)  # a robot unsure of its pose counts only what it surely sees
+        self._legs: dict[tuple[float, float, float, float], tuple[np.ndarray, np.ndarray]] = {}
 
     def window(self, x: float, y: float, theta: float) -> tuple[int, int, np.ndarray]:
         """(row0, col0, ticks) one step of the sensor adds from this pose."""
@@ -102,15 +107,42 @@ class Deposit:
             sure = sure.minimum(self.stares(stations + spread * np.array([math.cos(way), math.sin(way)]), angles))
         return sure.tocsc()
 
+    def leg_cells(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One straight leg from ``a`` to ``b`` flown at k_v facing along it, as :meth:`hops` flies each hop:
+        (flat indices of the cells it reaches, Λ* added to each). Kept for :data:`LEGS_KEPT` legs (a route's
+        legs are asked for again at every patch and cleanup)."""
+        key = (float(a[0]), float(a[1]), float(b[0]), float(b[1]))
+        found = self._legs.get(key)
+        if found is None:
+            ticks = np.zeros(self.shape, dtype=np.int64)
+            self._fly(ticks, np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
+            flat = np.flatnonzero(ticks)
+            found = (flat, ticks.ravel()[flat] / self.target_ticks)
+            if len(self._legs) >= LEGS_KEPT:
+                self._legs.pop(next(iter(self._legs)))
+            self._legs[key] = found
+        return found
+
+    def path(self, points: np.ndarray) -> np.ndarray:
+        """A polyline's legs flown one after another (:meth:`leg_cells`), per cell (Λ*, flat)."""
+        cells = np.zeros(self.shape[0] * self.shape[1])
+        for a, b in itertools.pairwise(np.asarray(points, dtype=np.float64)):
+            flat, added = self.leg_cells(a, b)
+            cells[flat] += added
+        return cells
+
+    def _fly(self, ticks: np.ndarray, a: np.ndarray, b: np.ndarray) -> None:
+        """Add to ``ticks`` the steps of the leg from ``a`` to ``b`` at k_v, facing along it (``b`` not reached)."""
+        heading = math.atan2(b[1] - a[1], b[0] - a[0])
+        steps = round(float(np.linalg.norm(b - a)) / (self.scenario.k_v * self.scenario.dt))
+        for k in range(steps):
+            x, y = a + (b - a) * k / steps
+            row0, col0, window = self.window(float(x), float(y), heading)
+            add_window(ticks, row0, col0, window, 1 << 62)
+
     def hops(self, stations: np.ndarray) -> np.ndarray:
         """The hops between consecutive stations flown straight at k_v, per cell (Λ*)."""
         ticks = np.zeros(self.shape, dtype=np.int64)
-        step = self.scenario.k_v * self.scenario.dt
         for a, b in itertools.pairwise(stations):
-            heading = math.atan2(b[1] - a[1], b[0] - a[0])
-            steps = round(float(np.linalg.norm(b - a)) / step)
-            for k in range(steps):
-                x, y = a + (b - a) * k / steps
-                row0, col0, window = self.window(float(x), float(y), heading)
-                add_window(ticks, row0, col0, window, 1 << 62)
+            self._fly(ticks, a, b)
         return ticks.ravel() / self.target_ticks

@@ -5,9 +5,9 @@ between bearings sweeps less than a stare. So routes leave cells short, scattere
 free robots to those cells one by one, nearest first, crosses the building back and forth (measured on the
 lab, N = 1: 32 cells left when the tour ended took 900 of the run's 3,300 time units). Instead:
 
-- **What is left to others** (:func:`residual_lack`): Υ less what the stops still ahead on the busy robots'
-  routes will add (:class:`model.controllers.anicov.deposit.Deposit`'s stares, the programme's model), so
-  that a free robot does not clean up what a teammate is about to stare at.
+- **What is left to others** (:func:`residual_lack`): Υ less what the stops and legs still ahead on the busy
+  robots' routes will add (:class:`model.controllers.anicov.deposit.Deposit`'s stares and legs, the
+  programme's model), so that a free robot does not clean up what a teammate is about to see.
 - **The stations** (:func:`cleanup_stations`): the reachable cells within R of a short cell, every
   :data:`CANDIDATE_STRIDE`-th row and column, plus a seer of its own for a short cell none of them sees; the
   least periods of their stares that bring each short cell :data:`CLEANUP_DEMAND` of its lack (the relaxed
@@ -80,9 +80,12 @@ bearings, a few hundred candidates cost a few tenths of a second)."""
 def residual_lack(
     deposit: Deposit, lack: np.ndarray, routes: list[Route], around: tuple[np.ndarray, float] | None = None
 ) -> np.ndarray:
-    """Υ (grid) less what the stops still ahead on ``routes`` will add, at least 0; ``around`` (point, radius):
-    only the stops within the radius of the point are counted (a stare reaches R: those farther than 2 R from
-    a point add nothing within R of it)."""
+    """Υ (grid) less what the stops and the legs still ahead on ``routes`` will add, at least 0; ``around``
+    (point, radius): only the stops and legs within the radius of the point are counted (a camera reaches R:
+    those farther than 2 R from a point add nothing within R of it). The legs count since the tour's stares
+    are planned beside what its hops see (:mod:`model.controllers.anicov.terrain_plan`): a robot leaving a
+    station that counted only stops patched there what its own next hop was to see (office, N = 1: 2,455.1
+    time units against 1,788.7)."""
     expected = np.zeros(lack.size)
     for route in routes:
         for stop in route.stops:
@@ -92,7 +95,29 @@ def residual_lack(
             for bearing in stop.bearings:
                 flat, added = deposit.stare_cells(float(x), float(y), float(bearing))
                 expected[flat] += added  # one stare reaches each cell once
+        for a, b in legs_ahead(route, around):
+            flat, added = deposit.leg_cells(a, b)
+            expected[flat] += added
     return np.maximum(lack.ravel() - expected, 0.0).reshape(lack.shape)
+
+
+def legs_ahead(route: Route, around: tuple[np.ndarray, float] | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The legs of ``route`` still to fly, from where the robot has come (its leg begun, from that point), those
+    that pass within ``around``'s radius of its point if given."""
+    ahead = route.points[route.along > route.progress + 1e-9]
+    points = np.vstack([route.point_at(route.progress)[None, :], ahead])
+    legs = list(itertools.pairwise(points))
+    if around is None:
+        return legs
+    centre, radius = around
+    return [(a, b) for a, b in legs if _gap_to_leg(centre, a, b) <= radius]
+
+
+def _gap_to_leg(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    leg = b - a
+    length = float(leg @ leg)
+    along = 0.0 if length == 0.0 else min(max(float((point - a) @ leg) / length, 0.0), 1.0)
+    return float(np.linalg.norm(a + along * leg - point))
 
 
 def station_patch(

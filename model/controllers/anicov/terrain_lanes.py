@@ -29,7 +29,7 @@ CORNER_TURN = math.radians(30.0)
 
 def terrain_routes(scenario: Scenario, positions: np.ndarray) -> tuple[list[np.ndarray], list[list[Stop]]]:
     """Every robot's route (M_i, 2) and its stops, from its position through its share of the tour."""
-    world, plan = world_of(scenario), tour_plan(scenario)
+    world, plan = world_of(scenario), tour_plan(scenario, positions)
     points, along, arrivals = tour_line(plan, scenario.k_v)
     shares = tour_shares(world, points, along, positions)
     routes, stops = [], []

@@ -3,9 +3,10 @@ by the length of the free path between them, and each hop's path.
 
 - **The order** (:func:`station_tour`): on the open square the serpentine's rows are the order, and a straight
   hop is the way. Among walls the straight distance lies: two stations on either side of a wall are near and
-  far apart. The tour starts at the serpentine's first station and always goes on to the nearest station
-  not visited yet by the free path's length (the geodesic field of each station, :meth:`World.field`), then
-  2-opt reverses any stretch that shortens it, until none does. A room's stations lie nearer each other than
+  far apart. The tour starts at a given station (:mod:`model.controllers.anicov.terrain_plan` tries the one
+  nearest each robot) and always goes on to the nearest station not visited yet by the free path's length
+  (the geodesic field of each station, :meth:`World.field`), then 2-opt reverses any stretch that shortens it,
+  until none does. A room's stations lie nearer each other than
   any station beyond its door, so the tour covers the building room by room, not back and forth.
 - **A hop's path** (:func:`hop_path`): the shortest path on the passage graph (the disk with its clearance
   and margin drives straight between joined cell centres: :mod:`model.world.world`), followed cell by cell
@@ -35,14 +36,14 @@ def travel_lengths(world: World, stations: np.ndarray) -> np.ndarray:
     return np.minimum(lengths, lengths.T)  # the graph is symmetric; both halves agree but for rounding
 
 
-def station_tour(lengths: np.ndarray) -> np.ndarray:
-    """The order (K,) of a tour over the stations from station 0: nearest unvisited first, then 2-opt on the
-    open path until no reversal shortens it."""
+def station_tour(lengths: np.ndarray, first: int = 0) -> np.ndarray:
+    """The order (K,) of a tour over the stations from station ``first``: nearest unvisited first, then 2-opt on
+    the open path (its first station kept) until no reversal shortens it."""
     count = len(lengths)
     if count < 3:
-        return np.arange(count)
-    tour, left = [0], np.ones(count, dtype=bool)
-    left[0] = False
+        return np.array([first, *(k for k in range(count) if k != first)], dtype=np.int64)[:count]
+    tour, left = [first], np.ones(count, dtype=bool)
+    left[first] = False
     for _ in range(count - 1):
         ahead = np.where(left, lengths[tour[-1]], np.inf)
         nearest = int(np.argmin(ahead))  # lowest index on a tie
