@@ -19,6 +19,7 @@ import numpy as np
 from model.controllers.anicov.route import CARROT_PERIOD, Stop
 from model.controllers.anicov.terrain_plan import TourPlan, tour_line, tour_of, tour_plan, tour_shares
 from model.controllers.anicov.terrain_routes import hop_path
+from model.paper.polyline import point_along
 from model.scenario import Scenario
 from model.world.reachability import in_reachable_cell, nearest_reachable
 from model.world.world import World, world_of
@@ -65,7 +66,9 @@ def _share(
     start, end = share
     period = CARROT_PERIOD * scenario.k_v
     inside = np.flatnonzero((along >= start - 1e-9) & (along <= end + 1e-9))
-    first = points[inside[0]] if len(inside) else points[np.searchsorted(along, start).clip(0, len(points) - 1)]
+    # A share begins and ends where the line is cut, inside a hop's leg as often as not: the leg's two parts are
+    # flown by the robots on either side (the tour's stares count every leg's view: terrain_plan).
+    first = np.array(point_along(points, along, start), dtype=np.float64)
     route = [*free_path(world, position, first)]
     wanted: list[tuple[int, list[float]]] = []
     stations = {tuple(station): k for k, station in enumerate(plan.stations)}
@@ -80,6 +83,9 @@ def _share(
         low, high = max(0, round((start - arrive) / period)), min(len(plan.bearings[k]), round((end - arrive) / period))
         if high > low:
             wanted.append((len(route) - 1, list(plan.bearings[k][low:high])))
+    last = np.array(point_along(points, along, end), dtype=np.float64)
+    if not np.allclose(route[-1], last):
+        route.append(last)
     route_points = np.array(route, dtype=np.float64).reshape(-1, 2)
     lengths = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(route_points, axis=0), axis=1))])
     wanted = sorted([*wanted, *corner_turns(route_points, {index for index, _ in wanted}, scenario)])

@@ -195,6 +195,8 @@ def _balanced(
         way = np.zeros(agents)
         way[pieces] = np.where(np.isfinite(ways[robots, pieces]), ways[robots, pieces], 0.0)
         lengths = np.maximum((total + way.sum()) / agents - way, 0.0)
+        if total <= 0.0 or lengths.sum() <= 0.0:  # nothing to share: the pieces stay empty
+            break
         cuts = np.concatenate([[0.0], np.cumsum(lengths * total / lengths.sum())])
     assert best is not None
     return best
