@@ -93,13 +93,15 @@ def test_team_survives_an_agent_killed_mid_run(tmp_path, clock):
     assert summary["completed"] is True and summary["final_error"] == 0.0
     counts = json.loads((out / "coordinator_counts.json").read_text())
     assert "agent 2 left" in counts["events"]
-    # The coordinator and every teammate notice through liveliness, within a second on loopback.
+    # The coordinator and every teammate notice through liveliness: within a second on loopback on a quiet
+    # machine (0.48 - 0.51 s for the agents), and the coordinator took 1.1 s on a fresh clone's CI run beside
+    # two sweeps on the two cores; the outer limit is generous, as the suite's waits are (no machine's speed).
     noticed = {"coordinator": "agent 2 left", **{f"agent-{i}": "teammate 2 left" for i in (0, 1, 3)}}
     detected_after = {}
     for process_name, line_says in noticed.items():
         lines = (out / "logs" / f"{process_name}.log").read_text().splitlines()
         detected_after[process_name] = log_time(next(line for line in lines if line_says in line)) - killed_at
-    assert all(seconds < 1.0 for seconds in detected_after.values()), detected_after
+    assert all(seconds < limit(3.0) for seconds in detected_after.values()), detected_after
     survivors = [json.loads((out / "logs" / f"agent-{i}.counts.json").read_text()) for i in (0, 1, 3)]
     assert all(agent["teammates_left"] == [2] for agent in survivors)
     # Every delta agent 2 published stays: the same sequences of it, and the same map, everywhere.
