@@ -6,8 +6,8 @@ by the length of the free path between them, and each hop's path.
   far apart. The tour starts at a given station (:mod:`model.controllers.anicov.terrain_plan` tries the one
   nearest each robot) and always goes on to the nearest station not visited yet by the free path's length
   (the geodesic field of each station, :meth:`World.field`), then 2-opt reverses any stretch that shortens it,
-  until none does. A room's stations lie nearer each other than
-  any station beyond its door, so the tour covers the building room by room, not back and forth.
+  until none does. A room's stations lie nearer each other than any station beyond its door, so the tour
+  covers the building room by room, not back and forth.
 - **A hop's path** (:func:`hop_path`): the shortest path on the passage graph (the disk with its clearance
   and margin drives straight between joined cell centres: :mod:`model.world.world`), followed cell by cell
   down the goal's field, then pulled tight: from each point it goes straight to the farthest later point a
