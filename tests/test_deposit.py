@@ -69,3 +69,20 @@ def test_a_sure_stare_is_the_least_of_the_station_s_and_of_eight_points_round_it
     assert np.array_equal(sure, least)
     assert (sure <= deposit.stares(station, angles).toarray()).all()
     assert sure.sum() < deposit.stares(station, angles).toarray().sum()  # the wall hides some from some points
+
+
+def test_sure_stares_kept_are_those_computed_afresh_station_by_station():
+    from model.world.world import world_of
+    from tests.test_terrain_stations import ROOMS
+
+    ground, angles, spread = world_of(ROOMS).ground, np.array([0.0, math.pi / 4, -2.0]), 0.3
+    kept = Deposit(ROOMS, ground, 5)
+    first = kept.sure_stares(np.array([[11.0, 3.5], [4.0, 4.0]]), angles, spread)
+    again = kept.sure_stares(np.array([[4.0, 4.0], [15.0, 6.0], [11.0, 3.5]]), angles, spread)  # two kept, one new
+    fresh = Deposit(ROOMS, ground, 5)
+    for k, station in enumerate(([4.0, 4.0], [15.0, 6.0], [11.0, 3.5])):
+        alone = fresh.sure_stares(np.array([station]), angles, spread)
+        assert alone.nnz > 0
+        assert (again[:, 3 * k : 3 * k + 3] != alone).nnz == 0
+    assert (again[:, 0:3] != first[:, 3:6]).nnz == 0
+    assert kept.sure_stares(np.zeros((0, 2)), angles, spread).shape == (ROOMS.grid_shape[0] * ROOMS.grid_shape[1], 0)

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from model.controllers.anicov.deposit import Deposit
-from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop, arrive_radius_of
+from model.controllers.anicov.route import Route, Stop, arrive_radius_of
 from model.controllers.anicov.terrain_cleanup import (
     cell_of,
     cleanup_pieces,
@@ -33,7 +33,7 @@ from model.controllers.anicov.terrain_cleanup import (
 )
 from model.controllers.anicov.terrain_lanes import free_path, piece_route
 from model.controllers.anicov.terrain_relief import aside, in_the_way, relief
-from model.controllers.anicov.terrain_stations import ANGLES
+from model.controllers.anicov.terrain_stations import ANGLES, deposit_among_walls
 from model.scenario import Scenario
 from model.scenario.physics_keys import pair_margin_of
 from model.world.world import world_of
@@ -61,7 +61,6 @@ class TerrainFlight:
     cleanup_wait: int = 0
     cleaning: dict[int, tuple[list[tuple[int, int]], np.ndarray, float]] = field(default_factory=dict)
     banned: set[tuple[int, int]] = field(default_factory=set)
-    deposit: Deposit | None = None
 
     def steer(
         self, routes: dict[int, Route], lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]
@@ -208,7 +207,4 @@ class TerrainFlight:
             self.banned.update(cells)
 
     def _deposit(self) -> Deposit:
-        if self.deposit is None:
-            world = world_of(self.scenario)
-            self.deposit = Deposit(self.scenario, world.ground, round(CARROT_PERIOD / self.scenario.dt))
-        return self.deposit
+        return deposit_among_walls(self.scenario)

@@ -26,12 +26,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linprog
 
-from model.controllers.anicov.deposit import Deposit
 from model.controllers.anicov.route import CARROT_PERIOD
 from model.controllers.anicov.routes import bottleneck_assignment
 from model.controllers.anicov.stations import BEARINGS, bearing_sequence, whole_periods
 from model.controllers.anicov.terrain_routes import hop_path, station_tour, travel_lengths
-from model.controllers.anicov.terrain_stations import Programme, programme_among_walls
+from model.controllers.anicov.terrain_stations import Programme, deposit_among_walls, programme_among_walls
 from model.paper.polyline import point_along
 from model.scenario import Scenario
 from model.world.reachability import nearest_reachable
@@ -107,7 +106,7 @@ def _stares_beside_hops(
     and its flight 2,426.1 -> 1,788.7 (the paper's law: 2,511.5); the field's flight 1,756.8 (30-seed mean) ->
     1,319.9."""
     world = world_of(scenario)
-    deposit = Deposit(scenario, world.ground, round(CARROT_PERIOD / scenario.dt))
+    deposit = deposit_among_walls(scenario)
     seen = sum((deposit.path(hop) for hop in hops), np.zeros(world.coverable.size))
     need = np.maximum(TOUR_DEMAND - seen[programme.rows], 0.0)
     columns = (order[:, None] * BEARINGS + np.arange(BEARINGS)).ravel()

@@ -87,6 +87,18 @@ def _keyed(scenario: Scenario) -> Scenario:
     return dataclasses.replace(scenario, agents=1, seed=0, max_time=1.0)
 
 
+def deposit_among_walls(scenario: Scenario) -> Deposit:
+    """What a stare of a carrot period adds past the scenario's walls (:class:`Deposit`), one per domain and sensor
+    in a process: the programme, the tour's hops and the flight's patches and cleanups share the legs and sure
+    stares it keeps (pure results, so sharing them changes nothing but the time)."""
+    return _deposit(_keyed(scenario))
+
+
+@functools.lru_cache(maxsize=8)
+def _deposit(scenario: Scenario) -> Deposit:
+    return Deposit(scenario, world_of(scenario).ground, round(CARROT_PERIOD / scenario.dt))
+
+
 @functools.cache
 def _programme(scenario: Scenario) -> Programme:
     world = world_of(scenario)
@@ -98,7 +110,7 @@ def _solved(world: World, spacing: float) -> Programme:
     """The programme at one spacing: the stations, those added for cells no stare reached, and HiGHS's
     relaxed periods."""
     scenario = world.scenario
-    deposit = Deposit(scenario, world.ground, round(CARROT_PERIOD / scenario.dt))
+    deposit = deposit_among_walls(scenario)
     stations = stations_among_walls(world, spacing)
     stares = deposit.stares(stations, ANGLES)
     coverable = world.coverable.ravel()
