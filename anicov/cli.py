@@ -140,6 +140,16 @@ def command_controller_table(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def command_maps_table(args: argparse.Namespace) -> int:
+    from anicov.maps_table import maps_table
+
+    table = maps_table([Path(out) for out in args.out], args.challenger)
+    if args.write:
+        Path(args.write).write_text(table)
+    print(table, end="")
+    return EXIT_OK
+
+
 def command_router(args: argparse.Namespace) -> int:
     import zenoh
 
@@ -279,6 +289,14 @@ def _add_sweep(commands: argparse._SubParsersAction) -> None:
         "e.g. mine.py:Mine)",
     )
     table.set_defaults(handler=command_controller_table)
+
+    maps = commands.add_parser(
+        "maps-table", help="issue 36's study: a controller against the paper's law on maps, goals checked"
+    )
+    maps.add_argument("out", nargs="+", help="one sweep's output directory per map (sweeps/anicov-maps/*.toml)")
+    maps.add_argument("--write", help="also write the Markdown table to this file")
+    maps.add_argument("--challenger", default="anicov", help="the controller set against the paper's law")
+    maps.set_defaults(handler=command_maps_table)
 
 
 def _add_bus_tools(commands: argparse._SubParsersAction) -> None:

@@ -5,13 +5,18 @@ order searched on the 2 soonest (model.controllers.anicov.piece_order), the rout
 twice patched (periods put in where they fall short), the last flight read for the orbits over what is left
 (model.controllers.anicov.touch_ups). In
 realtime the team waits this long for its first carrots; in lockstep and in the engine it is paid once per
-run. Issue 36's goal: at most 2 s at N = 100 on the paper's square.
+run. Issue 36's goals: at most 2 s at N = 100 on the paper's square, at most 10 s on the largest map of the
+corpus (``--maps``: the lab hall and the Málaga campus, fetched by ``./go maps``; among walls the first plan is
+the stations' programme, once per process and domain, then per team the tour, its shares and its stares beside
+the hops, :mod:`model.controllers.anicov.terrain_plan`).
 
     .venv/bin/python bench/bench_planner.py
+    .venv/bin/python bench/bench_planner.py --maps
 """
 
 from __future__ import annotations
 
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -25,6 +30,7 @@ from model.controllers.anicov.lane_planner import LanePlanner
 from model.controllers.anicov.stations import forget_layouts, layout
 from model.parameters import starting_poses
 from model.scenario import load_scenario
+from model.world.world import world_of
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 CASES = [
@@ -37,6 +43,13 @@ CASES = [
     ("wide.toml", 30),
 ]
 SEEDS = (0, 1, 2)
+MAP_CASES = [
+    ("real/uwb-lab.toml", 1),
+    ("real/uwb-lab.toml", 8),
+    ("real/malaga-campus.toml", 1),
+    ("real/malaga-campus.toml", 8),
+    ("real/malaga-campus.toml", 30),
+]
 
 
 def first_plan_seconds(config: str, agents: int, seed: int) -> tuple[float, int]:
@@ -60,7 +73,42 @@ def layout_seconds(config: str) -> float:
     return time.perf_counter() - started
 
 
+def map_first_plans(config: str, agents: int) -> tuple[float, list[float]]:
+    """(seconds of the first team's first plan in a fresh process, the stations' programme included; seconds of
+    the next teams', seeds 1 - 2), the world's geodesics built before, as the coordinator has them."""
+    first_plan_seconds("paper.toml", 1, 0)  # numba's kernels loaded before timing
+    timed = []
+    for seed in SEEDS:
+        scenario = load_scenario(SCENARIOS / config).with_overrides(controller="anicov", agents=agents, seed=seed)
+        world_of(scenario)
+        planner, positions = LanePlanner(scenario), starting_poses(scenario)[:, :2]
+        started = time.perf_counter()
+        planner.plan(np.ones(scenario.grid_shape), positions)
+        timed.append(time.perf_counter() - started)
+    return timed[0], timed[1:]
+
+
+def main_maps() -> None:
+    """Each case in a process of its own, so that the first team pays the programme as a run does."""
+    print(f"machine: {describe_machine()}")
+    print("| map | N | first team's first plan, s (programme included) | next teams', s |")
+    print("|---|---|---|---|")
+    for config, agents in MAP_CASES:
+        found = subprocess.run(
+            [sys.executable, __file__, "--map-case", config, str(agents)], capture_output=True, text=True, check=True
+        )
+        print(found.stdout.strip(), flush=True)
+
+
 def main() -> None:
+    if "--map-case" in sys.argv:
+        config, agents = sys.argv[-2], int(sys.argv[-1])
+        first, next_ = map_first_plans(config, agents)
+        print(f"| {config} | {agents} | {first:.2f} | {', '.join(f'{s:.2f}' for s in next_)} |")
+        return
+    if "--maps" in sys.argv:
+        main_maps()
+        return
     print(f"machine: {describe_machine()}")
     first_plan_seconds("paper.toml", 1, 0)  # numba's kernels loaded before timing
     for config in sorted({config for config, _ in CASES}):
