@@ -14,7 +14,7 @@ A sweep file::
 writes ``OUT/runs.csv``: one row per run, with every grid key, the seed and every figure of the run's
 summary (completed, completion_time, optimum_time, time_ratio, steps, team_path_length, final_error,
 the safety figures when robots have a body, the watchdog's interventions and cells given up, the radio's with a limited
-comm_range or local planning). Each row is written and flushed as its run ends, so a
+comm_range or local planning, and with ``physics = "mujoco"`` the contacts and the true coverage). Each row is written and flushed as its run ends, so a
 sweep killed at any point loses at most the runs under way; started again on the same OUT it reads the
 table (a last line cut by the kill is dropped), runs only what is missing and says how many it found.
 Locally it uses every core; ``--cluster ADDRESS`` sends the runs to the workers of a running Dask
@@ -59,6 +59,9 @@ FIGURES = (
     "teammates_heard_mean",
 )
 """The summary's figures a row carries (those a run does not have are left empty)."""
+PHYSICS_FIGURES = ("physical_contacts", "true_coverage", "true_cells_short")
+"""And those of a sweep with ``physics = "mujoco"`` in its base or grid (issue 37): a kinematic sweep's columns,
+and so its resumed tables, stay as they were."""
 SWEEP_KEYS = ("scenario", "seeds", "grid", "fixed")
 
 
@@ -71,8 +74,14 @@ class Sweep:
     seeds: list[int]
 
     @property
+    def figures(self) -> tuple[str, ...]:
+        """The figures its rows carry: :data:`FIGURES`, and :data:`PHYSICS_FIGURES` where a run has physics."""
+        physics = self.base.physics == "mujoco" or "mujoco" in self.grid.get("physics", [])
+        return FIGURES + PHYSICS_FIGURES if physics else FIGURES
+
+    @property
     def columns(self) -> list[str]:
-        return [*self.grid, "seed", *FIGURES]
+        return [*self.grid, "seed", *self.figures]
 
     def points(self) -> Iterator[dict[str, Any]]:
         """Every run's keys: each combination of the grid, for each seed."""
@@ -144,7 +153,7 @@ def run_point(sweep: Sweep, point: dict[str, Any]) -> dict[str, Any]:
             "watchdog_interventions": len(report.get("interventions", [])),
             "cells_given_up": report.get("cells_given_up", 0),
         }
-    return point | {figure: figures.get(figure) for figure in FIGURES}
+    return point | {figure: figures.get(figure) for figure in sweep.figures}
 
 
 def _key(point: dict[str, Any], names: list[str]) -> tuple[str, ...]:

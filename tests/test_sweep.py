@@ -180,3 +180,27 @@ def test_a_plug_in_controller_runs_in_a_sweep_its_file_relative_to_the_sweep_fil
     table = controller_table(tmp_path / "out", challenger="nearest_uncovered.py:NearestUncovered")
     assert "| N | paper t/t* | zigzag t/t* | nearest_uncovered.py:NearestUncovered t/t* |" in table
     assert "nearest_uncovered.py:NearestUncovered vs best other" in table
+
+
+PHYSICS = """
+seeds = 1
+[grid]
+physics = ["kinematic", "mujoco"]
+[fixed]
+domain = [12.0, 12.0]
+range = 4.0
+robot_radius = 0.4
+agents = 2
+"""
+
+
+def test_a_sweep_with_physics_carries_the_contacts_and_the_truth_and_a_kinematic_one_does_not(tmp_path):
+    sweep = load_sweep(write_sweep(tmp_path, text=PHYSICS))
+    assert run_sweep(sweep, tmp_path / "out", workers=1, progress=False) == (0, 2)
+    rows = {row["physics"]: row for row in rows_of(tmp_path / "out")}
+    assert rows["mujoco"]["completed"] == "True"
+    assert rows["mujoco"]["physical_contacts"] == "0"
+    assert float(rows["mujoco"]["true_coverage"]) == 1.0 and rows["mujoco"]["true_cells_short"] == "0"
+    assert rows["kinematic"]["physical_contacts"] == rows["kinematic"]["true_coverage"] == ""
+    kinematic = load_sweep(write_sweep(tmp_path, text=SMALL))
+    assert "true_coverage" not in kinematic.columns  # its tables, and resumed ones, keep their columns
