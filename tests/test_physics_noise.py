@@ -8,7 +8,17 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from model.physics.noise import Belief, CommandDelay, Noise, in_own_frame, moved_by, noise_of
+from model.physics.noise import (
+    Belief,
+    CommandDelay,
+    Noise,
+    fix_gains,
+    fused,
+    in_own_frame,
+    moved_by,
+    noise_of,
+    predicted_variance,
+)
 from model.scenario import validate
 from model.scenario.physics_keys import COVER_MARGIN
 
@@ -81,3 +91,36 @@ def test_the_noise_table_in_whole_control_periods():
     assert noise_of(validate({})).none and noise_of(validate({})).cover_margin == 0.0
     exact = validate({"robot_radius": 0.3, "physics": "mujoco", "noise": {"localiser_sigma": 0.05, "cover_margin": 0}})
     assert noise_of(exact).cover_margin == 0.0
+
+
+def test_a_fix_moves_the_belief_by_the_kalman_gain_whole_where_it_is_exact_not_at_all_where_the_belief_is():
+    noise = Noise(localiser_sigma=0.1, localiser_heading=0.02)
+    variance = np.array([[0.01, 0.0004], [0.0, 0.0]])
+    gains = fix_gains(variance, noise)
+    assert np.allclose(gains, [[0.5, 0.5], [0.0, 0.0]])  # P / (P + σ²); a belief known exactly keeps it
+    assert np.array_equal(fix_gains(variance, Noise()), np.ones((2, 2)))  # an exact fix replaces it
+    moved = fused(np.array([[0.0, 0.0, 3.1]]), np.array([[1.0, -2.0, -3.1]]), np.array([[0.5, 0.5]]))
+    assert np.allclose(moved, [[0.5, -1.0, math.pi]])  # the heading the short way round, across ±π
+
+
+def test_the_belief_s_variance_grows_with_the_way_travelled_and_turned():
+    noise = Noise(odometry_per_metre=0.1, odometry_per_radian=0.2)
+    grown = predicted_variance(np.array([[0.0, 0.01]]), np.array([[0.3, 0.1, -0.5]]), noise)
+    assert np.allclose(grown, [[0.01 * 0.4 + 0.4**2 * 0.01, 0.01 + 0.04 * 0.5]])
+    assert np.array_equal(predicted_variance(np.zeros((1, 2)), np.zeros((1, 3)), noise), np.zeros((1, 2)))
+
+
+def test_a_robot_standing_still_holds_its_belief_still_where_a_fix_replacing_it_jumped_by_sigma():
+    """At a station a robot faces bearings toward a carrot a few σ away: a belief that jumps by σ at every fix
+    swings its heading (docs/physics.md)."""
+    noise = Noise(odometry_per_metre=0.01, odometry_per_radian=0.01, localiser_sigma=0.05, localiser_period=1,
+                  localiser_delay=1)  # fmt: skip
+    start = np.array([[1.0, 1.0, 0.0]])
+    belief = Belief(noise, start, seed=3)
+    for _ in range(50):  # it drives, so the belief has some doubt to take fixes with
+        start = moved_by(start, np.array([[0.1, 0.0, 0.0]]))
+        belief.update(start)
+    standing = np.stack([belief.update(start)[0, :2] for _ in range(100)])
+    jumps = np.hypot(*np.diff(standing, axis=0).T)
+    assert jumps.max() < 0.2 * noise.localiser_sigma
+    assert np.hypot(*(standing[-1] - start[0, :2])) < 3.0 * noise.localiser_sigma

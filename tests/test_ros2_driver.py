@@ -327,6 +327,38 @@ def test_a_fix_sent_before_the_odometry_of_its_instant_is_read_before_it():
         robot.close()
 
 
+def test_with_the_scenario_s_noise_a_later_fix_moves_the_pose_by_the_kalman_gain_as_the_belief_does():
+    """The first fix places the robot whole; the odometry's drift over 1 m (20 units) grows its doubt; the next
+    fix, 0.1 m off, moves it by P / (P + σ²) of that (model.physics.noise), not whole: a pose that jumped by
+    σ at every fix swung a standing robot's heading (docs/physics.md)."""
+    from model.physics.noise import noise_of, predicted_variance
+    from model.scenario import validate
+
+    noise = {"localiser_sigma": 2.0, "odometry_per_metre": 0.3, "localiser_rate": 0.05, "clearance_reserve": 0.0}
+    given = {**SCENARIO.to_dict(), "robot_radius": 1.0, "physics": "mujoco", "safety_range": 200.0, "noise": noise}
+    scenario = validate(given)
+    variance = predicted_variance(np.zeros((1, 2)), np.array([[20.0, 0.0, 0.0]]), noise_of(scenario))
+    gain = variance[0, 0] / (variance[0, 0] + 2.0**2)
+    options = Ros2Options(namespace="bot1", localiser_topic="amcl_pose", sim_time=True, lockstep=True)
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = Ros2Robot(driver, options, scenario, agent=0)
+
+        def instant(stamp: int, odometry: tuple[float, float, float], fix: tuple[float, float, float]) -> bool:
+            base_session.put("bot1/amcl_pose", encode_pose(POSE_WITH_COVARIANCE, fix, stamp, "map"))
+            base_session.put("bot1/odom", encode_pose(ODOMETRY, odometry, stamp, "odom"))
+            return robot.has_pose()
+
+        assert wait_until(lambda: instant(0, (0.0, 0.0, 0.0), (1.0, 2.0, 0.0)))
+        assert robot.current_pose() == pytest.approx((20.0, 40.0, 0.0))  # the first fix, whole
+        robot.command(0.0, 0.0)
+        base.next()
+        instant(10**8, (1.0, 0.0, 0.0), (2.1, 2.0, 0.0))  # 1 m on by odometry; the fix 0.1 m further
+        assert robot.current_pose() == pytest.approx((20.0 + 20.0 + 2.0 * gain, 40.0, 0.0))
+        assert 0.05 < gain < 0.95
+        robot.close()
+
+
 def test_a_payload_that_is_not_a_pose_is_rejected_and_counted():
     with bus() as (driver, base_session):
         robot = Ros2Robot(driver, Ros2Options(namespace="bot1"), SCENARIO, agent=0)

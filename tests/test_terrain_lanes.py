@@ -74,3 +74,12 @@ def test_the_face_radius_is_the_open_square_s_there_and_half_a_step_among_walls_
     assert arrive_radius_of(slow) == 0.22 * slow.dt  # a step: within a sixteenth of the 1.0 cell
     fine = slow.with_overrides(cell=0.25, domain=[24.0, 16.0])
     assert arrive_radius_of(fine) == 0.25 / 16
+
+
+def test_with_late_commands_the_face_radius_is_twice_the_way_gone_before_a_command_reaches_the_wheels():
+    """A robot told to stop runs on k_v × latency: with a face radius of half a step it turned back for its
+    station again and again (two rooms, commands 0.1 late: 450 - 517 time units against 158 - 168)."""
+    late = validate({**ROOMS.to_dict(), "controller": "anicov", "physics": "mujoco", "noise": {"command_latency": 0.3}})
+    assert face_radius_of(late) == pytest.approx(2.0 * late.k_v * 0.3)
+    seen = late.with_overrides(noise={"command_latency": 0.3, "localiser_sigma": 0.2})
+    assert face_radius_of(seen) == pytest.approx(6.0 * 0.2)  # the localiser's jitter, wider here

@@ -3,7 +3,10 @@
 It publishes velocity commands on the base's command topic and keeps the latest odometry (callback
 thread, under a lock); with a localiser (``localiser_topic``, e.g. AMCL's ``amcl_pose``) each of its
 poses corrects the map ← odom transform, as ROS's own map → odom tf does, otherwise that transform is
-the fixed ``odom_offset``. Odometry is what tells whether the pose is fresh: a localiser publishes only
+the fixed ``odom_offset``. Where the scenario's ``[noise]`` states the localiser's σ, a fix moves the pose by
+the Kalman gain of the odometry's doubt against the fix's, as the in-process belief does
+(:mod:`model.physics.noise`: the odometry's drift grows the doubt as the robot travels); without it a fix is
+taken whole. Odometry is what tells whether the pose is fresh: a localiser publishes only
 when its filter updates (AMCL: after 0.2 m or 0.5 rad of motion by default), so a robot standing still
 would never hear from it. What the driver does for a real base's sake:
 
@@ -36,9 +39,11 @@ import time
 from collections import deque
 from collections.abc import Callable
 
+import numpy as np
 import zenoh
 
 from model.paper.dynamics import unicycle_step
+from model.physics.noise import fix_gains, fused, noise_of, predicted_variance
 from model.scenario import Scenario
 from protocol.ros2.frames import Pose, compose, frame_of, invert, scale_into
 from protocol.ros2.messages import BadRosMessage, RosPose, decode_pose, encode_velocity
@@ -82,6 +87,8 @@ class Ros2Robot:
         self._early_fix: RosPose | None = None  # a localiser's fix stamped after the newest odometry
         self._acted_stamp: int | None = None  # sim_time: the stamp of the odometry the last step acted on
         self._offset: Pose | None = None if options.localiser_topic else options.odom_offset  # map ← odom
+        self._noise, self._metres_per_unit = noise_of(scenario), scenario.metres_per_unit
+        self._variance = np.zeros((1, 2))  # the pose's doubt (scenario units², rad²): the first fix is the start
         self._stale_since: float | None = None  # control thread only: the odometry went stale then
         self._acting: Pose | None = None  # control thread only: the pose this step acts on (None: hold)
         self._send_lock = threading.Lock()  # the control loop and the watchdog both send
@@ -136,6 +143,10 @@ class Ros2Robot:
         if read is None:
             return
         with self._lock:
+            if self._odometry is not None:
+                self._variance = predicted_variance(
+                    self._variance, self._motion(self._odometry, read.pose), self._noise
+                )
             self._odometry = read.pose
             self._received_at = time.monotonic()
             self._history.append((read.stamp_ns, read.pose))
@@ -157,10 +168,21 @@ class Ros2Robot:
             self._correct(read)
 
     def _correct(self, fix: RosPose) -> None:
-        """map ← odom from a fix and the odometry nearest its stamp (under the lock)."""
+        """map ← odom from a fix and the odometry nearest its stamp (under the lock): the first taken whole,
+        later ones by their gain."""
         _, odometry = min(self._history, key=lambda entry: abs(entry[0] - fix.stamp_ns))
-        self._offset = compose(fix.pose, invert(odometry))
+        pose = fix.pose
+        if self._offset is not None:
+            gains = fix_gains(self._variance, self._noise)
+            pose = tuple(fused(np.array([compose(self._offset, odometry)]), np.array([fix.pose]), gains)[0])
+            self._variance = (1.0 - gains) * self._variance
+        self._offset = compose(pose, invert(odometry))
         self.counters["localiser_poses"] += 1
+
+    def _motion(self, before: Pose, after: Pose) -> np.ndarray:
+        """(1, 3) the base's motion between two odometry poses, in its own frame and the scenario's units."""
+        x, y, turn = compose(invert(before), after)
+        return np.array([[x / self._metres_per_unit, y / self._metres_per_unit, turn]])
 
     # ------------------------------------------------------------ pose (the control thread)
 
