@@ -17,6 +17,7 @@ from model.safety.safety import (
     FILTER_CHANGED,
     KEEPING_RIGHT,
     MEMORY_SIZE,
+    NO_SAFE_COMMAND,
     PARKED,
     STALE_NEIGHBOUR,
     TEAMMATE,
@@ -212,6 +213,26 @@ def test_a_wall_keeps_its_barrier(x: float, y: float, theta: float, v_hat: float
     assert abs(v) <= V_MAX + 1e-9 and abs(omega) <= OMEGA_MAX + 1e-9
     after = unicycle_step(x, y, theta, v, omega, WALLED.dt)
     assert wall_gap(after[0], after[1]) >= (1.0 - WALLED_SAFETY.decay) * h - 1e-9
+
+
+def test_a_robot_inside_a_wall_s_margin_along_the_wall_turns_out_instead_of_standing_for_good() -> None:
+    """A centre put inside the margin (a belief off the truth, a late command) nearly along the wall: no v gets it
+    out at the barrier's rate, and the filter used to stop it, v = ω = 0, at every step (two rooms with the
+    issue's noise: for the rest of the run). Asked only not to go deeper, it turns and leaves, never deeper."""
+    pose = np.array([[11.0 + 0.9 * (WALLED_SAFETY.radius + WALLED_SAFETY.margin), 10.0, math.pi / 2 + 0.05]])
+    memory = np.zeros(MEMORY_SIZE, dtype=np.int64)
+    gaps, stopped = [wall_gap(pose[0, 0], pose[0, 1])], 0
+    assert gaps[0] < 0.0
+    for _ in range(100):  # the law drives on along the wall, as a carrot ahead asks
+        v, omega, flags = filter_command(
+            1.0, 0.0, 0, pose, np.zeros(1), np.zeros(1, dtype=np.int64), WALLED_GROUND, 1.0, WALLED_SAFETY, memory
+        )
+        stopped += bool(flags & NO_SAFE_COMMAND)
+        pose[0] = unicycle_step(*pose[0], v, omega, WALLED.dt)
+        gaps.append(wall_gap(pose[0, 0], pose[0, 1]))
+    assert stopped == 0
+    assert min(gaps) >= gaps[0] - 1e-9  # never deeper
+    assert gaps[-1] >= 0.0 and pose[0, 1] > 11.0  # out of the margin, on along the wall past the block
 
 
 def test_a_teammate_held_again_and_again_yields_to_a_robot_hemmed_by_a_wall() -> None:
