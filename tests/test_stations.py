@@ -218,3 +218,33 @@ def test_turning_in_puts_the_turn_from_the_way_in_before_the_first_stare_and_onl
     assert turned[-2:] == [math.pi, math.pi] and len(turned) == 3  # one period turning: half way round
     assert abs(math.remainder(turned[0], 2 * math.pi)) == pytest.approx(math.pi / 2)
     assert bearing_sequence(periods, math.pi, None, math.pi / 2, turn_in=True) == plain  # already facing it
+
+
+def eager_whole_periods(stares, need, relaxed):
+    """whole_periods as it was before the lazy greedy: every column's gain computed at every period."""
+    periods = np.floor(relaxed + 1e-6)
+    missing = need - stares @ periods
+    by_column = stares.T.tocsr()
+    clipped = by_column.copy()
+    while (missing > 1e-9).any():
+        clipped.data = np.minimum(by_column.data, np.maximum(missing, 0.0)[by_column.indices])
+        gain = np.asarray(clipped.sum(axis=1)).ravel()
+        best = int(np.argmax(gain))
+        periods[best] += 1.0
+        missing -= stares[:, best].toarray().ravel()
+    return periods.astype(int)
+
+
+def test_the_lazy_greedy_picks_the_periods_every_gain_computed_each_time_picks_ties_and_all():
+    from scipy.sparse import random as sparse_random
+
+    rng = np.random.default_rng(5)
+    for trial in range(40):
+        cells, columns = int(rng.integers(20, 120)), int(rng.integers(5, 60))
+        stares = sparse_random(cells, columns, density=0.2, random_state=trial, format="csc")
+        if trial % 2:
+            stares.data = np.round(stares.data * 4) / 4 + 0.25  # few distinct values: many ties between columns
+        reached = np.asarray(stares.sum(axis=1)).ravel() > 0
+        need = np.where(reached, rng.uniform(0.5, 2.0, cells), 0.0)
+        relaxed = rng.uniform(0.0, 1.5, columns)
+        assert np.array_equal(whole_periods(stares, need, relaxed), eager_whole_periods(stares, need, relaxed))

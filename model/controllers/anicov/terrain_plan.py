@@ -58,15 +58,16 @@ def tour_plan(scenario: Scenario, positions: np.ndarray | None = None) -> TourPl
     staring = np.flatnonzero(periods.sum(axis=1) > 0)
     lengths = travel_lengths(world, programme.stations[staring])
     best: tuple[float, np.ndarray, TourPlan] | None = None
+    known: dict[tuple[bytes, bytes], np.ndarray] = {}
     for first in _first_stations(world, programme.stations[staring], positions):
         order = staring[station_tour(lengths, first)]
-        plan = tour_of(world, programme.stations[order], periods[order], scenario)
+        plan = tour_of(world, programme.stations[order], periods[order], scenario, known)
         finish = 0.0 if positions is None else _finish(world, plan, positions, scenario.k_v)
         if best is None or finish < best[0] - 1e-9:
             best = (finish, order, plan)
     assert best is not None
     _, order, plan = best
-    return tour_of(world, plan.stations, _stares_beside_hops(scenario, programme, order, plan.hops), scenario)
+    return tour_of(world, plan.stations, _stares_beside_hops(scenario, programme, order, plan.hops), scenario, known)
 
 
 def _first_stations(world: World, stations: np.ndarray, positions: np.ndarray | None) -> list[int]:
@@ -120,11 +121,19 @@ def _stares_beside_hops(
     return whole_periods(stares, need, relaxed.x).reshape(len(order), BEARINGS)
 
 
-def tour_of(world: World, stations: np.ndarray, periods: np.ndarray, scenario: Scenario) -> TourPlan:
+def tour_of(
+    world: World,
+    stations: np.ndarray,
+    periods: np.ndarray,
+    scenario: Scenario,
+    known: dict[tuple[bytes, bytes], np.ndarray] | None = None,
+) -> TourPlan:
     """The tour over ``stations`` (K, 2) in this order, each with its whole ``periods`` (K, BEARINGS): the hops
     between them as free paths, and at each its bearings in one sweep, arriving along the hop in and leaving
-    along the hop out."""
-    hops = tuple(hop_path(world, a, b) for a, b in itertools.pairwise(stations))
+    along the hop out. ``known``: hops found before, by their ends, taken from there and kept there (the tours
+    :func:`tour_plan` compares share most of their hops: on the campus at N = 30, 7,309 hops for 29 tours)."""
+    known = {} if known is None else known
+    hops = tuple(_hop(world, a, b, known) for a, b in itertools.pairwise(stations))
     turn = math.pi * scenario.k_omega * CARROT_PERIOD
     bearings = []
     for k, row in enumerate(periods):
@@ -132,6 +141,13 @@ def tour_of(world: World, stations: np.ndarray, periods: np.ndarray, scenario: S
         leave = _heading(hops[k][0], hops[k][1]) if k < len(hops) and len(hops[k]) > 1 else None
         bearings.append(tuple(bearing_sequence(row, arrive, leave, turn, turn_in=True)))
     return TourPlan(np.asarray(stations, dtype=np.float64).reshape(-1, 2), tuple(bearings), hops)
+
+
+def _hop(world: World, a: np.ndarray, b: np.ndarray, known: dict[tuple[bytes, bytes], np.ndarray]) -> np.ndarray:
+    key = (np.asarray(a, dtype=np.float64).tobytes(), np.asarray(b, dtype=np.float64).tobytes())
+    if key not in known:
+        known[key] = hop_path(world, a, b)
+    return known[key]
 
 
 def _heading(a: np.ndarray, b: np.ndarray) -> float:
