@@ -356,6 +356,11 @@ def test_with_the_scenario_s_noise_a_later_fix_moves_the_pose_by_the_kalman_gain
         instant(10**8, (1.0, 0.0, 0.0), (2.1, 2.0, 0.0))  # 1 m on by odometry; the fix 0.1 m further
         assert robot.current_pose() == pytest.approx((20.0 + 20.0 + 2.0 * gain, 40.0, 0.0))
         assert 0.05 < gain < 0.95
+        heard = robot.counts()["poses_received"]
+        instant(10**8, (1.0, 0.0, 0.0), (2.1, 2.0, 0.0))  # sent again, as the simulator does while it waits
+        assert wait_until(lambda: robot.counts()["poses_received"] > heard)  # the odometry after the fix: both read
+        assert robot.pose() == pytest.approx((20.0 + 20.0 + 2.0 * gain, 40.0, 0.0))  # taken once
+        assert robot.counts()["localiser_poses"] == 2
         robot.close()
 
 

@@ -89,6 +89,7 @@ class Ros2Robot:
         self._offset: Pose | None = None if options.localiser_topic else options.odom_offset  # map ← odom
         self._noise, self._metres_per_unit = noise_of(scenario), scenario.metres_per_unit
         self._variance = np.zeros((1, 2))  # the pose's doubt (scenario units², rad²): the first fix is the start
+        self._fused_stamp: int | None = None  # the stamp of the latest fix taken: a fix sent again is not taken again
         self._stale_since: float | None = None  # control thread only: the odometry went stale then
         self._acting: Pose | None = None  # control thread only: the pose this step acts on (None: hold)
         self._send_lock = threading.Lock()  # the control loop and the watchdog both send
@@ -169,7 +170,11 @@ class Ros2Robot:
 
     def _correct(self, fix: RosPose) -> None:
         """map ← odom from a fix and the odometry nearest its stamp (under the lock): the first taken whole,
-        later ones by their gain."""
+        later ones by their gain, each once (the simulator in lockstep sends an instant's readings again while it
+        waits for commands; fused twice, a fix would count as two)."""
+        if self._fused_stamp is not None and fix.stamp_ns <= self._fused_stamp:
+            return
+        self._fused_stamp = fix.stamp_ns
         _, odometry = min(self._history, key=lambda entry: abs(entry[0] - fix.stamp_ns))
         pose = fix.pose
         if self._offset is not None:
