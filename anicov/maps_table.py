@@ -46,10 +46,11 @@ def _misses(rows: dict[str, list[dict[str, str]]], less: float, radius: float) -
         short = sum(row["completed"] != "True" for row in runs)
         if short:
             misses.append(f"{controller}: {short} incomplete")
-        if _least(runs, "min_separation") < 2.0 * radius:
-            misses.append(f"{controller}: a collision (centre gap {_least(runs, 'min_separation'):.3f} < 2r)")
-        if _least(runs, "min_clearance") < radius:
-            misses.append(f"{controller}: a wall contact (clearance {_least(runs, 'min_clearance'):.3f} < r)")
+        gap, clearance = _least(runs, "min_separation"), _least(runs, "min_clearance")
+        if gap < 2.0 * radius:
+            misses.append(f"{controller}: a collision (centre gap {gap:.3f} < 2r)")
+        if clearance < radius:
+            misses.append(f"{controller}: a wall contact (clearance {clearance:.3f} < r)")
     if not less >= LESS_GOAL:
         misses.append(f"{100 * less:.1f} % less, not {100 * LESS_GOAL:.0f} %")
     return misses

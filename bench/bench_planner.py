@@ -79,12 +79,8 @@ def map_first_plans(config: str, agents: int) -> tuple[float, list[float]]:
     first_plan_seconds("paper.toml", 1, 0)  # numba's kernels loaded before timing
     timed = []
     for seed in SEEDS:
-        scenario = load_scenario(SCENARIOS / config).with_overrides(controller="anicov", agents=agents, seed=seed)
-        world_of(scenario)
-        planner, positions = LanePlanner(scenario), starting_poses(scenario)[:, :2]
-        started = time.perf_counter()
-        planner.plan(np.ones(scenario.grid_shape), positions)
-        timed.append(time.perf_counter() - started)
+        world_of(load_scenario(SCENARIOS / config).with_overrides(controller="anicov", agents=agents, seed=seed))
+        timed.append(first_plan_seconds(config, agents, seed)[0])
     return timed[0], timed[1:]
 
 

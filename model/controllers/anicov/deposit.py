@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from typing import Any, TypeVar
 
 import numpy as np
 from numba import njit
@@ -21,6 +22,8 @@ from model.scenario import Scenario
 from model.scenario.physics_keys import sure_doubt_of
 from model.world.ground import Ground, open_ground
 from model.world.wedge import sense_wedge_among
+
+T = TypeVar("T")
 
 LEGS_KEPT = 4096
 """The legs :meth:`Deposit.leg_cells` keeps (the oldest goes first)."""
@@ -51,6 +54,14 @@ def _cells_of(
                 added[k] = (value * period_steps) / target_ticks
                 k += 1
     return flat, added
+
+
+def _kept(store: dict[Any, T], key: Any, value: T, most: int) -> T:
+    """``value``, kept in ``store`` under ``key``; the oldest kept goes first when ``most`` are."""
+    if len(store) >= most:
+        store.pop(next(iter(store)), None)
+    store[key] = value
+    return value
 
 
 class Deposit:
@@ -123,10 +134,7 @@ class Deposit:
             for way in np.arange(8) * math.pi / 4:
                 shifted = station + spread * np.array([math.cos(way), math.sin(way)])
                 found = found.minimum(self.stares(shifted[None, :], angles))
-            found = found.tocsc()
-            if len(self._sure) >= SURE_STATIONS_KEPT:
-                self._sure.pop(next(iter(self._sure)), None)
-            self._sure[key] = found
+            found = _kept(self._sure, key, found.tocsc(), SURE_STATIONS_KEPT)
         return found
 
     def leg_cells(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -139,10 +147,7 @@ class Deposit:
             ticks = np.zeros(self.shape, dtype=np.int64)
             self._fly(ticks, np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
             flat = np.flatnonzero(ticks)
-            found = (flat, ticks.ravel()[flat] / self.target_ticks)
-            if len(self._legs) >= LEGS_KEPT:
-                self._legs.pop(next(iter(self._legs)), None)
-            self._legs[key] = found
+            found = _kept(self._legs, key, (flat, ticks.ravel()[flat] / self.target_ticks), LEGS_KEPT)
         return found
 
     def path(self, points: np.ndarray) -> np.ndarray:
