@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import shutil
 import subprocess
 import sys
@@ -114,6 +115,10 @@ def command_sweep(args: argparse.Namespace) -> int:
     sweep = load_sweep(Path(args.sweep))
     if args.workers is not None and args.workers < 1:
         raise ScenarioError(f"--workers: expected a positive number, got {args.workers}")
+    if args.seeds is not None:
+        if args.seeds < 1:
+            raise ScenarioError(f"--seeds: expected a positive number, got {args.seeds}")
+        sweep = dataclasses.replace(sweep, seeds=sweep.seeds[: args.seeds])
     total = len(list(sweep.points()))
     found, made = run_sweep(sweep, Path(args.out), args.workers, args.cluster, progress=not args.quiet)
     where = f"on the cluster at {args.cluster}" if args.cluster else "on this machine"
@@ -144,6 +149,16 @@ def command_maps_table(args: argparse.Namespace) -> int:
     from anicov.maps_table import maps_table
 
     table = maps_table([Path(out) for out in args.out], args.challenger)
+    if args.write:
+        Path(args.write).write_text(table)
+    print(table, end="")
+    return EXIT_OK
+
+
+def command_physics_table(args: argparse.Namespace) -> int:
+    from anicov.physics_table import physics_table
+
+    table = physics_table([Path(out) for out in args.out])
     if args.write:
         Path(args.write).write_text(table)
     print(table, end="")
@@ -265,6 +280,12 @@ def _add_sweep(commands: argparse._SubParsersAction) -> None:
     sweep.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
     sweep.add_argument("--cluster", metavar="ADDRESS", help="a Dask distributed scheduler, e.g. tcp://host:8786")
     sweep.add_argument("--quiet", action="store_true", help="no progress bar")
+    sweep.add_argument(
+        "--seeds",
+        type=int,
+        metavar="K",
+        help="only the file's first K seeds (a study in stages: the rest run later on the same OUT, which resumes)",
+    )
     sweep.set_defaults(handler=command_sweep)
 
     plot = commands.add_parser(
@@ -297,6 +318,15 @@ def _add_sweep(commands: argparse._SubParsersAction) -> None:
     maps.add_argument("--write", help="also write the Markdown table to this file")
     maps.add_argument("--challenger", default="anicov", help="the controller set against the paper's law")
     maps.set_defaults(handler=command_maps_table)
+
+    physics = commands.add_parser(
+        "physics-table", help="issue 37's study: kinematic, physics and physics with noise per map, goals checked"
+    )
+    physics.add_argument(
+        "out", nargs="+", help="sweep output directories (sweeps/physics/*.toml): <map> and <map>-noise per map"
+    )
+    physics.add_argument("--write", help="also write the Markdown table to this file")
+    physics.set_defaults(handler=command_physics_table)
 
 
 def _add_bus_tools(commands: argparse._SubParsersAction) -> None:

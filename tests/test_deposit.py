@@ -7,7 +7,9 @@ import pytest
 
 from model.controllers.anicov.deposit import Deposit
 from model.paper.coverage_map import add_window
+from model.parameters import coverage_map_of
 from model.scenario import load_scenario
+from model.scenario.physics_keys import COVER_MARGIN, cover_margin_of
 from model.world.wedge import sense_wedge_among
 
 PAPER = Path(__file__).resolve().parents[1] / "scenarios" / "paper.toml"
@@ -86,3 +88,17 @@ def test_sure_stares_kept_are_those_computed_afresh_station_by_station():
         assert (again[:, 3 * k : 3 * k + 3] != alone).nnz == 0
     assert (again[:, 0:3] != first[:, 3:6]).nnz == 0
     assert kept.sure_stares(np.zeros((0, 2)), angles, spread).shape == (ROOMS.grid_shape[0] * ROOMS.grid_shape[1], 0)
+
+
+def test_with_noise_a_stare_is_counted_in_the_team_map_s_units_which_ask_the_cover_margin_more():
+    """The team's map asks (1 + cover_margin) Λ* of each cell with noise: a stare counted in Λ* made every station
+    leave its cells that much short (the square, N = 10: cleanups of 400 - 700 cells)."""
+    plain = small()
+    noisy = plain.with_overrides(
+        physics="mujoco", robot_radius=0.4, noise={"localiser_sigma": 0.05, "localiser_rate": 10.0}
+    )
+    assert cover_margin_of(noisy) == COVER_MARGIN > 0.0
+    assert Deposit(noisy).target_ticks == coverage_map_of(noisy).target_ticks
+    assert Deposit(plain).target_ticks == coverage_map_of(plain).target_ticks
+    stare, plain_stare = Deposit(noisy).stare(12.3, 7.9, 0.7), Deposit(plain).stare(12.3, 7.9, 0.7)
+    assert np.allclose(stare * (1.0 + COVER_MARGIN), plain_stare, rtol=1e-6)

@@ -61,6 +61,19 @@ def test_a_stopped_sweep_runs_only_what_it_lacks_and_drops_a_cut_line(tmp_path):
     assert len(rows_of(out)) == 8 and len({tuple(r.values()) for r in rows_of(out)}) == 8
 
 
+def test_a_study_run_in_stages_takes_the_first_seeds_then_resumes_with_the_rest(tmp_path, capsys):
+    from anicov.cli import main
+
+    path, out = write_sweep(tmp_path, seeds=3, text=SMALL.replace("agents = [1, 2]", "agents = [1]")), tmp_path / "out"
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--quiet", "--seeds", "1"]) == 0
+    assert sorted((r["controller"], r["seed"]) for r in rows_of(out)) == [("paper", "0"), ("zigzag", "0")]
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    assert "sweep: 6 runs; 2 found done" in capsys.readouterr().out
+    assert sorted(r["seed"] for r in rows_of(out)) == ["0", "0", "1", "1", "2", "2"]
+    assert main(["sweep", str(path), "--out", str(out), "--seeds", "0"]) != 0
+    assert "--seeds: expected a positive number, got 0" in capsys.readouterr().err
+
+
 def flaky_run(sweep, point):
     """run_point, but the zig-zag pair of two fails (module level: the pool's workers import it)."""
     if point["agents"] == 2 and point["controller"] == "zigzag":

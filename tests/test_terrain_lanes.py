@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from model.controllers.anicov.lane_planner import LanePlanner
-from model.controllers.anicov.route import FACE_RADIUS, Route, arrive_radius_of, face_radius_of
+from model.controllers.anicov.route import FACE_RADIUS, NOISE_FACE_SIGMAS, Route, arrive_radius_of, face_radius_of
 from model.controllers.anicov.terrain_lanes import corner_turns, terrain_routes
 from model.controllers.anicov.terrain_plan import tour_plan
 from model.scenario import validate
@@ -81,5 +81,6 @@ def test_with_late_commands_the_face_radius_is_twice_the_way_gone_before_a_comma
     station again and again (two rooms, commands 0.1 late: 450 - 517 time units against 158 - 168)."""
     late = validate({**ROOMS.to_dict(), "controller": "anicov", "physics": "mujoco", "noise": {"command_latency": 0.3}})
     assert face_radius_of(late) == pytest.approx(2.0 * late.k_v * 0.3)
-    seen = late.with_overrides(noise={"command_latency": 0.3, "localiser_sigma": 0.2})
-    assert face_radius_of(seen) == pytest.approx(6.0 * 0.2)  # the localiser's jitter, wider here
+    sigma = 0.8 / NOISE_FACE_SIGMAS
+    seen = late.with_overrides(noise={"command_latency": 0.3, "localiser_sigma": sigma})
+    assert face_radius_of(seen) == pytest.approx(0.8)  # the localiser's jitter, wider here

@@ -8,7 +8,10 @@ import pytest
 
 from model.controllers.anicov.route import Route, Stop
 from model.controllers.anicov.terrain_relief import RELIEF_GAIN, aside, in_the_way, relief, time_left
+from model.scenario import load_scenario
+from model.scenario.physics_keys import pair_margin_of
 from model.world.world import world_of
+from tests.teamrun import ROOT
 from tests.test_terrain_stations import ROOMS
 
 
@@ -59,3 +62,19 @@ def test_a_robot_with_nothing_to_do_in_a_teammate_s_way_is_sent_aside_out_of_it(
     assert place is not None and not in_the_way(busy, place, gap, 0.5)
     assert world.reachable[int(place[1] // ROOMS.cell), int(place[0] // ROOMS.cell)]
     assert np.hypot(*(place - standing)) < 1.5 * gap + ROOMS.cell  # near: the nearest clear cell by the free path
+
+
+def test_a_robot_standing_outside_the_team_s_space_is_still_sent_aside():
+    """With the issue's noise the clearance reserve takes the cells beside the rooms' wall out of the team's space,
+    and a robot's disk still stands there (its centre 0.9 off the wall). Measured from its own cell no free path
+    went anywhere, and it held a teammate orbiting the station beside it to the end of the run (two rooms, seed 7)."""
+    rooms = load_scenario(ROOT / "scenarios" / "physics-rooms.toml")
+    world = world_of(rooms)
+    standing = np.array([11.1, 12.09])
+    assert not world.reachable[12, 11]
+    busy = Route.of(np.array([[9.15, 12.87], [9.5, 12.5], [9.5, 0.5]]), stops=[Stop(0.51, [0.0])])
+    gap = 2.0 * (2.0 * rooms.robot_radius + pair_margin_of(rooms)) + rooms.lookahead
+    assert in_the_way(busy, standing, gap, 0.5)
+    place = aside(world, standing, [busy], gap)
+    assert place is not None and not in_the_way(busy, place, gap, 0.5)
+    assert world.reachable[int(place[1] // rooms.cell), int(place[0] // rooms.cell)]

@@ -68,6 +68,11 @@ SURE_SPREADS = 1.5
 stand up to its arrival radius off (route.arrive_radius_of, at most a step); sure over 1.5 arrival radii, the
 lab's cleanups asked for stares too few cells pass and its runs stalled (four of four trials), so the spread
 stays the face radius's, which held in every run of the study."""
+SEER_SPREADS = (SURE_SPREADS, 0.5, 0.0)
+"""The spreads, in face radii, a short cell's own seer is sure over (:func:`_sure_seer`), widest first: a cell seen
+only through a gap, from one cell's centre, is seen from no point a noisy localiser's face radius round it
+(the MRPT lab, σ 0.05 m on cells of 0.2 m: 7 - 16 cells stood short for ever with no station, the run never done).
+A narrower seer may be flown in vain; its cleanup is then judged and banned (:mod:`terrain_flight`)."""
 SEERS_TRIED = 5
 """A short cell that no candidate's sure stare reaches tries this many of its nearest seers."""
 SHIFT_SPREADS = 3.0
@@ -274,23 +279,25 @@ def _sure_seer(
     """(station, its sure stares) that reach the cell ``flat``: among the :data:`SEERS_TRIED` nearest seers not
     banned (:meth:`World.seers_of`, the cells whose centres see it), the first whose centre, or a point
     :data:`SHIFT_SPREADS` face radii from it toward one of 8 ways, sees it from everywhere a robot standing there
-    may be (a cell seen past a wall's corner is seen from one side of a line through the seer, not the other)."""
+    may be (a cell seen past a wall's corner is seen from one side of a line through the seer, not the other);
+    where none does, the same over each narrower spread of :data:`SEER_SPREADS`."""
     scenario = world.scenario
-    cell, spread = scenario.cell, SURE_SPREADS * face_radius_of(scenario)
+    cell, face = scenario.cell, face_radius_of(scenario)
     row, col = divmod(flat, scenario.grid_shape[1])
     seers = [s for s in world.seers_of((col + 0.5) * cell, (row + 0.5) * cell)[:, 1:] if cell_of(s, cell) not in banned]
     ways = np.array([(0.0, 0.0), *((np.cos(a), np.sin(a)) for a in np.arange(8) * np.pi / 4)])
     ground = world.ground
-    for seer in seers[:SEERS_TRIED]:
-        for way in ways:
-            station = seer + SHIFT_SPREADS * face_radius_of(scenario) * way
-            if not in_reachable_cell(world.reachable, *station, scenario.cell):
-                continue  # a wide face radius (a noisy localiser's) shifts it off the team's space: no path goes there
-            if not in_sight(ground.wall_grid, *seer, *station, ground.grain, ground.plan_radius, ground.bounded):
-                continue  # the disk with its clearance does not fit there: the filter would hold it short
-            stares = deposit.sure_stares(station[None, :], ANGLES, spread)
-            if stares[flat].sum() > 0.0:
-                return station, stares
+    for spread in SEER_SPREADS:
+        for seer in seers[:SEERS_TRIED]:
+            for way in ways:
+                station = seer + SHIFT_SPREADS * face * way
+                if not in_reachable_cell(world.reachable, *station, scenario.cell):
+                    continue  # a wide face radius (a noisy localiser's) shifts it off the team's space: no path goes there
+                if not in_sight(ground.wall_grid, *seer, *station, ground.grain, ground.plan_radius, ground.bounded):
+                    continue  # the disk with its clearance does not fit there: the filter would hold it short
+                stares = deposit.sure_stares(station[None, :], ANGLES, spread * face)
+                if stares[flat].sum() > 0.0:
+                    return station, stares
     return None
 
 

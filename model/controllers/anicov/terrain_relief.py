@@ -21,6 +21,7 @@ from scipy.spatial import cKDTree
 
 from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop
 from model.controllers.anicov.terrain_lanes import free_path
+from model.world.reachability import nearest_reachable
 from model.world.world import World
 
 RELIEF_GAIN = 4.0
@@ -102,7 +103,10 @@ def aside(world: World, position: np.ndarray, ways: list[Route], gap: float) -> 
     clear = cKDTree(blocked).query(centres)[0] >= 1.5 * gap
     if not clear.any():
         return None
-    field = world.field(float(position[0]), float(position[1]))
+    # A robot may stand in a cell outside the team's space (the filter keeps its disk off the wall, not its centre
+    # off the cell's): the free paths are measured from the reachable cell nearest it, as free_path goes.
+    start = nearest_reachable(world.reachable, np.asarray(position, dtype=np.float64)[None, :], cell)[0]
+    field = world.field(float(start[0]), float(start[1]))
     rows, cols = np.floor(centres[clear, 1] / cell).astype(int), np.floor(centres[clear, 0] / cell).astype(int)
     lengths = field[rows, cols]
     if not np.isfinite(lengths).any():

@@ -1,0 +1,142 @@
+"""Issue 37's study table: each controller kinematic, in the physics world without noise and with the issue's
+noise, per map and team size (``anicov physics-table DIR [DIR ...]``, the sweeps of ``sweeps/physics/``).
+
+A map has two sweeps: ``<map>`` (``[grid] physics = ["kinematic", "mujoco"]``, no noise) and ``<map>-noise``
+(physics with ``[noise]``); a DIR's name without ``-noise`` is the map's. A row's mode is read from the row's
+``physics`` (or the sweep's base, DIR/sweep.json, where the grid does not hold it) and the base's noise.
+
+Per map, team size and controller: the mean time of each mode over its completed runs, how much longer the
+noisy runs take than the kinematic ones, the runs complete, the physics runs' contacts and their least true
+coverage. The issue's goals are checked over every run:
+
+- every run complete;
+- ``physical_contacts`` = 0 in every physics run (the safety filter on);
+- ``true_coverage`` at least :data:`TRUE_COVERAGE_GOAL` at declared completion in every physics run;
+- the noisy runs' mean time within :data:`TIME_GOAL` of the kinematic runs'.
+
+A goal missed names what missed it; a mode a map has no run of is "—" and checks nothing.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import defaultdict
+from pathlib import Path
+
+from anicov.controller_table import read_runs
+
+TRUE_COVERAGE_GOAL = 0.995
+TIME_GOAL = 0.15
+MODES = ("kinematic", "physics", "noise")
+NOISE_SUFFIX = "-noise"
+HEADER = (
+    "| map | N | controller | kinematic | physics (more by) | physics and noise (more by) | complete (k / p / n) "
+    "| contacts (p / n) | least true coverage (p / n) | goals |"
+)
+
+Runs = dict[str, list[dict[str, str]]]
+"""A map's runs at one team size and controller, by mode."""
+
+
+def map_name(out_dir: Path) -> str:
+    """The map a sweep's DIR holds runs of: its name without :data:`NOISE_SUFFIX`."""
+    name = out_dir.name
+    return name[: -len(NOISE_SUFFIX)] if name.endswith(NOISE_SUFFIX) else name
+
+
+def _mode(row: dict[str, str], base: dict[str, object]) -> str:
+    physics = row.get("physics") or str(base.get("physics", "kinematic"))
+    if physics == "kinematic":
+        return "kinematic"
+    return "noise" if base.get("noise") else "physics"
+
+
+def collect(out_dirs: list[Path]) -> dict[str, dict[tuple[int, str], Runs]]:
+    """Every sweep's rows: map → (team size, controller) → mode → runs, maps in the order first given."""
+    maps: dict[str, dict[tuple[int, str], Runs]] = {}
+    for out_dir in out_dirs:
+        base = json.loads((out_dir / "sweep.json").read_text(encoding="utf-8"))["base"]
+        groups = maps.setdefault(map_name(out_dir), defaultdict(lambda: defaultdict(list)))
+        for key, rows in read_runs(out_dir).items():
+            for row in rows:
+                groups[key][_mode(row, base)].append(row)
+    return maps
+
+
+def _mean_time(runs: list[dict[str, str]]) -> float:
+    times = [float(row["completion_time"]) for row in runs if row["completed"] == "True"]
+    return sum(times) / len(times) if times else math.nan
+
+
+def _least(runs: list[dict[str, str]], key: str) -> float:
+    found = [float(row[key]) for row in runs if row.get(key, "") not in ("", "nan")]
+    return min(found) if found else math.nan
+
+
+def _contacts(runs: list[dict[str, str]]) -> int:
+    return sum(int(float(row["physical_contacts"])) for row in runs if row.get("physical_contacts", ""))
+
+
+def misses(runs: Runs) -> list[str]:
+    """What of the issue's goals one map's runs at one team size and controller miss (see the module)."""
+    found = []
+    for mode in MODES:
+        short = sum(row["completed"] != "True" for row in runs.get(mode, []))
+        if short:
+            found.append(f"{mode}: {short} of {len(runs[mode])} incomplete")
+    for mode in ("physics", "noise"):
+        if contacts := _contacts(runs.get(mode, [])):
+            found.append(f"{mode}: {contacts} contacts")
+        least = _least(runs.get(mode, []), "true_coverage")
+        if least < TRUE_COVERAGE_GOAL:
+            found.append(f"{mode}: true coverage {100 * least:.2f} % < {100 * TRUE_COVERAGE_GOAL:.1f} %")
+    more = _mean_time(runs.get("noise", [])) / _mean_time(runs.get("kinematic", [])) - 1.0
+    if more > TIME_GOAL:
+        found.append(f"noise: {100 * more:+.1f} % over kinematic, not within {100 * TIME_GOAL:.0f} %")
+    return found
+
+
+def _figure(value: float, digits: int, unit: str = "") -> str:
+    return "—" if math.isnan(value) else f"{value:,.{digits}f}{unit}"
+
+
+def _pair(runs: Runs, mode: str, kinematic: float) -> str:
+    mean = _mean_time(runs.get(mode, []))
+    return "—" if math.isnan(mean) else f"{mean:,.1f} ({100 * (mean / kinematic - 1.0):+.1f} %)"
+
+
+def row_cells(name: str, agents: int, controller: str, runs: Runs) -> list[str]:
+    """One line of the table (see the module)."""
+    kinematic = _mean_time(runs.get("kinematic", []))
+    done = " / ".join(
+        f"{sum(row['completed'] == 'True' for row in runs[mode])}/{len(runs[mode])}" if runs.get(mode) else "—"
+        for mode in MODES
+    )
+    contacts = " / ".join(str(_contacts(runs[mode])) if runs.get(mode) else "—" for mode in ("physics", "noise"))
+    coverage = " / ".join(
+        _figure(100 * _least(runs.get(mode, []), "true_coverage"), 2, " %") for mode in ("physics", "noise")
+    )
+    missed = misses(runs)
+    return [
+        name,
+        str(agents),
+        controller,
+        _figure(kinematic, 1),
+        _pair(runs, "physics", kinematic),
+        _pair(runs, "noise", kinematic),
+        done,
+        contacts,
+        coverage,
+        "met" if not missed else "missed: " + "; ".join(missed),
+    ]
+
+
+def physics_table(out_dirs: list[Path]) -> str:
+    """The Markdown table of the sweeps in ``out_dirs`` (see the module)."""
+    lines = [HEADER, "|" + "---|" * HEADER.count(" | ") + "---|"]
+    for name, groups in collect(out_dirs).items():
+        for agents, controller in sorted(groups):
+            cells = row_cells(name, agents, controller, groups[(agents, controller)])
+            lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
