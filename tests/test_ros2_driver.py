@@ -364,6 +364,40 @@ def test_with_the_scenario_s_noise_a_later_fix_moves_the_pose_by_the_kalman_gain
         robot.close()
 
 
+def test_a_fix_s_own_covariance_is_its_doubt_when_first_and_its_weight_after():
+    """A real localiser says how sure each fix is (the covariance's diagonal): the first fix, taken whole, leaves
+    the robot that doubt; a later one moves it by P / (P + its own variance); one that says nothing (all zero,
+    ROS's "unknown") is weighed by the scenario's σ."""
+    from model.scenario import validate
+
+    noise = {"localiser_sigma": 2.0, "localiser_rate": 0.05, "clearance_reserve": 0.0}  # no drift: P holds still
+    given = {**SCENARIO.to_dict(), "robot_radius": 1.0, "physics": "mujoco", "safety_range": 200.0, "noise": noise}
+    scenario = validate(given)
+    options = Ros2Options(namespace="bot1", localiser_topic="amcl_pose", sim_time=True, lockstep=True)
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = Ros2Robot(driver, options, scenario, agent=0)
+
+        def instant(stamp: int, fix: tuple[float, float, float], sigma: tuple[float, float]) -> bool:
+            base_session.put("bot1/amcl_pose", encode_pose(POSE_WITH_COVARIANCE, fix, stamp, "map", sigma=sigma))
+            base_session.put("bot1/odom", encode_pose(ODOMETRY, (0.0, 0.0, 0.0), stamp, "odom"))
+            return robot.has_pose()
+
+        def step() -> None:
+            robot.command(0.0, 0.0)
+            base.next()
+
+        assert wait_until(lambda: instant(0, (1.0, 2.0, 0.0), (0.1, 0.05)))  # 0.1 m: 2 units, P = 4
+        assert robot.current_pose() == pytest.approx((20.0, 40.0, 0.0))
+        step()
+        instant(10**8, (1.1, 2.0, 0.0), (0.1, 0.05))  # 2 units off, its own variance 4: gain 1/2
+        assert robot.current_pose() == pytest.approx((21.0, 40.0, 0.0))
+        step()
+        instant(2 * 10**8, (1.15, 2.0, 0.0), (0.0, 0.0))  # 2 units off again; the scenario's σ² = 4, P = 2
+        assert robot.current_pose() == pytest.approx((21.0 + 2.0 / 3.0, 40.0, 0.0))
+        robot.close()
+
+
 def test_a_payload_that_is_not_a_pose_is_rejected_and_counted():
     with bus() as (driver, base_session):
         robot = Ros2Robot(driver, Ros2Options(namespace="bot1"), SCENARIO, agent=0)

@@ -8,7 +8,15 @@ import numpy as np
 import pytest
 from rosbags.typesys import Stores, get_typestore
 
-from protocol.ros2.messages import BadRosMessage, dds_type_name, decode_pose, encode_velocity, type_hash
+from protocol.ros2.messages import (
+    BadRosMessage,
+    covariance_of,
+    dds_type_name,
+    decode_pose,
+    encode_pose,
+    encode_velocity,
+    type_hash,
+)
 from protocol.ros2.options import ODOMETRY, POSE_WITH_COVARIANCE, TWIST, TWIST_STAMPED
 
 STORE = get_typestore(Stores.ROS2_JAZZY)
@@ -95,3 +103,25 @@ def test_type_names_and_hashes_are_those_ros_2_uses():
     # The hash rmw_zenoh's design document shows in its Twist key (docs/design.md, jazzy).
     assert type_hash(TWIST).startswith("RIHS01_9c45bf16fe0983d80e3cfe750d6835843d265a9a6c46bd2e609fcddde6fb8d2a")
     assert type_hash(TWIST, "humble") == type_hash(TWIST, "kilted") == type_hash(TWIST)
+
+
+def test_a_covariance_that_says_nothing_is_none_and_one_that_does_is_read():
+    assert covariance_of([0.0] * 36) is None
+    given = [0.0] * 36
+    given[0], given[7], given[35] = 0.01, 0.03, 0.002
+    assert covariance_of(given) == pytest.approx((0.02, 0.002))
+    given[35] = float("nan")
+    assert covariance_of(given) is None
+    given[35], given[0] = 0.002, -1.0  # a negative variance: not one
+    assert covariance_of(given) is None
+
+
+def test_a_fix_s_covariance_is_read_with_its_pose():
+    fix = decode_pose(
+        encode_pose(POSE_WITH_COVARIANCE, (1.0, 2.0, 0.5), 7, "map", sigma=(0.1, 0.05)), POSE_WITH_COVARIANCE
+    )
+    assert fix.pose == pytest.approx((1.0, 2.0, 0.5)) and fix.stamp_ns == 7
+    assert fix.variance == pytest.approx((0.01, 0.0025))
+    assert (
+        decode_pose(encode_pose(POSE_WITH_COVARIANCE, (1.0, 2.0, 0.5), 7, "map"), POSE_WITH_COVARIANCE).variance is None
+    )

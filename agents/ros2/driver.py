@@ -43,7 +43,7 @@ import numpy as np
 import zenoh
 
 from model.paper.dynamics import unicycle_step
-from model.physics.noise import fix_gains, fused, noise_of, predicted_variance
+from model.physics.noise import fix_gains, fused, gains_against, noise_of, predicted_variance
 from model.scenario import Scenario
 from protocol.ros2.frames import Pose, compose, frame_of, invert, scale_into
 from protocol.ros2.messages import BadRosMessage, RosPose, decode_pose, encode_velocity
@@ -169,16 +169,26 @@ class Ros2Robot:
             self._correct(read)
 
     def _correct(self, fix: RosPose) -> None:
-        """map ← odom from a fix and the odometry nearest its stamp (under the lock): the first taken whole,
-        later ones by their gain, each once (the simulator in lockstep sends an instant's readings again while it
-        waits for commands; fused twice, a fix would count as two)."""
+        """map ← odom from a fix and the odometry nearest its stamp (under the lock): the first taken whole, with
+        the doubt its covariance gives (none where it gives none: the operator's initial pose, as the simulator
+        sends the start); later ones by their gain against their covariance, or the scenario's σ where they give
+        none; each once (the simulator in lockstep sends an instant's readings again while it waits for commands;
+        fused twice, a fix would count as two)."""
         if self._fused_stamp is not None and fix.stamp_ns <= self._fused_stamp:
             return
         self._fused_stamp = fix.stamp_ns
         _, odometry = min(self._history, key=lambda entry: abs(entry[0] - fix.stamp_ns))
         pose = fix.pose
-        if self._offset is not None:
-            gains = fix_gains(self._variance, self._noise)
+        measured = None
+        if fix.variance is not None:  # metres² to the scenario's units²
+            measured = np.array([[fix.variance[0] / self._metres_per_unit**2, fix.variance[1]]])
+        if self._offset is None:
+            if measured is not None:
+                self._variance = measured
+        else:
+            gains = (
+                fix_gains(self._variance, self._noise) if measured is None else gains_against(self._variance, measured)
+            )
             pose = tuple(fused(np.array([compose(self._offset, odometry)]), np.array([fix.pose]), gains)[0])
             self._variance = (1.0 - gains) * self._variance
         self._offset = compose(pose, invert(odometry))

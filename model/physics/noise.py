@@ -144,7 +144,12 @@ def predicted_variance(variance: np.ndarray, motion: np.ndarray, noise: Noise) -
 def fix_gains(variance: np.ndarray, noise: Noise) -> np.ndarray:
     """(N, 2) the Kalman gains K = P / (P + σ²) of a localiser's fix in position and heading, P the belief's
     variance (:func:`predicted_variance`), σ the fix's: 1 where the fix is exact, 0 where the belief is."""
-    measured = np.array([noise.localiser_sigma**2, noise.localiser_heading**2])
+    return gains_against(variance, np.array([noise.localiser_sigma**2, noise.localiser_heading**2]))
+
+
+def gains_against(variance: np.ndarray, measured: np.ndarray) -> np.ndarray:
+    """:func:`fix_gains` for a fix whose variance (position per axis, heading) is ``measured``: a real
+    localiser's covariance, which a ROS 2 driver reads from each fix."""
     total = variance + measured
     exact = total <= 0.0
     return np.where(exact, 1.0, variance / np.where(exact, 1.0, total))

@@ -72,6 +72,16 @@ class RosPose:
     pose: Pose
     frame_id: str
     stamp_ns: int
+    variance: tuple[float, float] | None = None  # (m² per axis, rad²) the covariance's diagonal; None: not given
+
+
+def covariance_of(covariance: object) -> tuple[float, float] | None:
+    """(x and y's mean variance, yaw's) from a PoseWithCovariance's row-major 6 × 6 covariance; None where it says
+    nothing: all zero (ROS's "unknown"), or any of the three negative or not finite."""
+    values = [float(covariance[index]) for index in (0, 7, 35)]  # type: ignore[index]
+    if not all(math.isfinite(value) and value >= 0.0 for value in values) or not any(values):
+        return None
+    return 0.5 * (values[0] + values[1]), values[2]
 
 
 def decode_pose(payload: bytes, typename: str, distribution: str = "jazzy") -> RosPose:
@@ -95,6 +105,7 @@ def decode_pose(payload: bytes, typename: str, distribution: str = "jazzy") -> R
         (float(pose.position.x), float(pose.position.y), theta),
         message.header.frame_id,
         stamp.sec * 1_000_000_000 + stamp.nanosec,
+        covariance_of(message.pose.covariance),
     )
 
 
