@@ -75,6 +75,14 @@ def test_each_goal_missed_is_named(tmp_path):
     assert "physics" not in row.split("missed:")[1]  # the physics runs met theirs
 
 
+def test_physics_without_noise_must_keep_within_the_time_goal_too(tmp_path):
+    dirs = rooms(tmp_path, [(4, "anicov", 0, True, 120.0, 0, 1.0)])
+    with open(dirs[0] / "runs.csv", "a", newline="") as file:
+        csv.writer(file).writerow((4, "anicov", "mujoco", 2, True, 160.0, 0, 1.0))  # physics now 126.7: +15.2 %
+    row = physics_table(dirs).splitlines()[2]
+    assert "missed: physics: +15.2 % over kinematic, not within 15 %" in row
+
+
 def test_a_map_s_name_drops_the_noise_suffix(tmp_path):
     assert map_name(tmp_path / "lab-noise") == "lab"
     assert map_name(tmp_path / "lab") == "lab"
