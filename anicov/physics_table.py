@@ -23,8 +23,10 @@ import json
 import math
 from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
 from anicov.controller_table import read_runs
+from model.scenario.physics_keys import RULES
 
 TRUE_COVERAGE_GOAL = 0.995
 TIME_GOAL = 0.15
@@ -45,11 +47,14 @@ def map_name(out_dir: Path) -> str:
     return name[: -len(NOISE_SUFFIX)] if name.endswith(NOISE_SUFFIX) else name
 
 
-def _mode(row: dict[str, str], base: dict[str, object]) -> str:
+def _mode(row: dict[str, str], base: dict[str, Any]) -> str:
+    """A row's mode: its physics, and with physics whether the base has any noise (its rules, such as
+    ``cover_margin`` alone, are not noise: :func:`model.scenario.physics_keys.cover_margin_of` reads it so)."""
     physics = row.get("physics") or str(base.get("physics", "kinematic"))
     if physics == "kinematic":
         return "kinematic"
-    return "noise" if base.get("noise") else "physics"
+    noise = dict(base.get("noise") or {})
+    return "noise" if any(value > 0.0 for key, value in noise.items() if key not in RULES) else "physics"
 
 
 def collect(out_dirs: list[Path]) -> dict[str, dict[tuple[int, str], Runs]]:
@@ -85,13 +90,22 @@ def misses(runs: Runs) -> list[str]:
         short = sum(row["completed"] != "True" for row in runs.get(mode, []))
         if short:
             found.append(f"{mode}: {short} of {len(runs[mode])} incomplete")
+    kinematic = _mean_time(runs.get("kinematic", []))
     for mode in ("physics", "noise"):
-        if contacts := _contacts(runs.get(mode, [])):
+        rows = runs.get(mode, [])
+        if not rows:
+            continue
+        if contacts := _contacts(rows):
             found.append(f"{mode}: {contacts} contacts")
-        least = _least(runs.get(mode, []), "true_coverage")
+        if unjudged := sum(row.get("true_coverage", "") in ("", "nan") for row in rows):
+            found.append(f"{mode}: {unjudged} runs without a true coverage")
+        least = _least(rows, "true_coverage")
         if least < TRUE_COVERAGE_GOAL:
             found.append(f"{mode}: true coverage {100 * least:.2f} % < {100 * TRUE_COVERAGE_GOAL:.1f} %")
-        more = _mean_time(runs.get(mode, [])) / _mean_time(runs.get("kinematic", [])) - 1.0
+        if math.isnan(kinematic):
+            found.append(f"{mode}: no complete kinematic run to time it against")
+            continue
+        more = _mean_time(rows) / kinematic - 1.0
         if more > TIME_GOAL:
             found.append(f"{mode}: {100 * more:+.1f} % over kinematic, not within {100 * TIME_GOAL:.0f} %")
     return found
@@ -103,7 +117,9 @@ def _figure(value: float, digits: int, unit: str = "") -> str:
 
 def _pair(runs: Runs, mode: str, kinematic: float) -> str:
     mean = _mean_time(runs.get(mode, []))
-    return "—" if math.isnan(mean) else f"{mean:,.1f} ({100 * (mean / kinematic - 1.0):+.1f} %)"
+    if math.isnan(mean):
+        return "—"
+    return f"{mean:,.1f}" if math.isnan(kinematic) else f"{mean:,.1f} ({100 * (mean / kinematic - 1.0):+.1f} %)"
 
 
 def row_cells(name: str, agents: int, controller: str, runs: Runs) -> list[str]:

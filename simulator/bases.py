@@ -42,6 +42,7 @@ class Reading:
     odometry: Pose
     velocity: tuple[float, float]  # m/s, rad/s: the command the wheels took
     fixes: tuple[tuple[int, Pose], ...] = ()
+    start: bool = False  # the fix is the start pose, exact (as an operator gives AMCL its initial pose)
 
 
 class SimulatedBases:
@@ -94,7 +95,8 @@ class SimulatedBases:
     ) -> list[Reading]:
         """What every base publishes now (at the start: its odometry and, with a localiser, its known start
         pose as the first fix, as an operator gives AMCL its initial pose)."""
-        if not arrived and self.step == 0 and self.localiser:
+        start = not arrived and self.step == 0 and self.localiser
+        if start:
             arrived = [(0, self.team.truth)]
         commands = self.commands if commands is None else commands
         readings = []
@@ -109,6 +111,7 @@ class SimulatedBases:
                     self.frame.pose_to_map(tuple(self.odometry[agent])),
                     self.frame.to_ros_velocity(float(commands[agent, 0]), float(commands[agent, 1])),
                     fixes,
+                    start,
                 )
             )
         return readings

@@ -168,17 +168,16 @@ class Publishers:
         self.fixes = [publisher(i, options.localiser_topic) for i in range(bases.agents) if bases.localiser]
         noise = bases.noise
         self.sigma = (noise.localiser_sigma * bases.scenario.metres_per_unit, noise.localiser_heading)
-        self.started = [False] * bases.agents  # each base's first fix sent
 
     def publish(self, readings: list[Reading]) -> None:
         """A base's fixes go before its odometry: the driver pairs a fix with the odometry of its stamp, and
         the step's pose must already hold the fixes that arrived with it."""
         for reading in readings:
             for stamp, pose in reading.fixes:
-                # The first is the start, exact, as an operator gives AMCL its initial pose: no covariance (ROS's
-                # "unknown"), which the driver takes with no doubt, as the in-process belief starts.
-                sigma = self.sigma if self.started[reading.agent] else (0.0, 0.0)
-                self.started[reading.agent] = True
+                # The start pose is exact, as an operator gives AMCL its initial pose: no covariance (ROS's
+                # "unknown"), which the driver takes with no doubt, as the in-process belief starts; every time it is
+                # sent again for a driver that came up late.
+                sigma = (0.0, 0.0) if reading.start else self.sigma
                 self.fixes[reading.agent].put(encode_pose(POSE_WITH_COVARIANCE, pose, stamp, "map", sigma=sigma))
             self.odometry[reading.agent].put(
                 encode_pose(ODOMETRY, reading.odometry, reading.stamp_ns, "odom", velocity=reading.velocity)

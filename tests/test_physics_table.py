@@ -86,3 +86,18 @@ def test_physics_without_noise_must_keep_within_the_time_goal_too(tmp_path):
 def test_a_map_s_name_drops_the_noise_suffix(tmp_path):
     assert map_name(tmp_path / "lab-noise") == "lab"
     assert map_name(tmp_path / "lab") == "lab"
+
+
+def test_a_sweep_whose_noise_holds_only_rules_is_physics_and_a_run_the_goals_cannot_judge_is_named(tmp_path):
+    plain = sweep_dir(
+        tmp_path,
+        "corridor",
+        {"physics": "mujoco", "noise": {"cover_margin": 0.05}},  # a rule, not noise
+        ["agents", "controller", "seed", *FIGURES],
+        [(2, "paper", 0, True, 50.0, 0, ""), (2, "paper", 1, False, 80.0, 0, 1.0)],  # no truth; no kinematic run
+    )
+    row = physics_table([plain]).splitlines()[2]
+    assert row.startswith("| corridor | 2 | paper | — | 50.0 | — | — / 1/2 / — |")
+    assert "physics: 1 runs without a true coverage" in row
+    assert "physics: no complete kinematic run to time it against" in row
+    assert "nan" not in row

@@ -370,7 +370,7 @@ def test_a_fix_s_own_covariance_is_its_doubt_when_first_and_its_weight_after():
     ROS's "unknown") is weighed by the scenario's σ."""
     from model.scenario import validate
 
-    noise = {"localiser_sigma": 2.0, "localiser_rate": 0.05, "clearance_reserve": 0.0}  # no drift: P holds still
+    noise = {"localiser_sigma": 2.0, "odometry_per_metre": 0.3, "localiser_rate": 0.05, "clearance_reserve": 0.0}
     given = {**SCENARIO.to_dict(), "robot_radius": 1.0, "physics": "mujoco", "safety_range": 200.0, "noise": noise}
     scenario = validate(given)
     options = Ros2Options(namespace="bot1", localiser_topic="amcl_pose", sim_time=True, lockstep=True)
@@ -387,6 +387,7 @@ def test_a_fix_s_own_covariance_is_its_doubt_when_first_and_its_weight_after():
             robot.command(0.0, 0.0)
             base.next()
 
+        # The odometry stands still: P grows by no drift between the fixes.
         assert wait_until(lambda: instant(0, (1.0, 2.0, 0.0), (0.1, 0.05)))  # 0.1 m: 2 units, P = 4
         assert robot.current_pose() == pytest.approx((20.0, 40.0, 0.0))
         step()
@@ -395,6 +396,29 @@ def test_a_fix_s_own_covariance_is_its_doubt_when_first_and_its_weight_after():
         step()
         instant(2 * 10**8, (1.15, 2.0, 0.0), (0.0, 0.0))  # 2 units off again; the scenario's σ² = 4, P = 2
         assert robot.current_pose() == pytest.approx((21.0 + 2.0 / 3.0, 40.0, 0.0))
+        robot.close()
+
+
+def test_without_a_model_of_the_odometry_s_drift_every_fix_is_taken_whole_whatever_its_covariance():
+    """A scenario with no [noise] (a real robot's, scenarios/ros2-paper.toml) has no drift to weigh a fix against:
+    the doubt would never grow, a fix's gain would fall as 1 / n and the localiser would be ignored."""
+    options = Ros2Options(namespace="bot1", localiser_topic="amcl_pose", sim_time=True, lockstep=True)
+    with bus() as (driver, base_session):
+        base = Base(base_session, "bot1/cmd_vel")
+        robot = Ros2Robot(driver, options, SCENARIO, agent=0)
+
+        def instant(stamp: int, fix: tuple[float, float, float]) -> bool:
+            base_session.put("bot1/amcl_pose", encode_pose(POSE_WITH_COVARIANCE, fix, stamp, "map", sigma=(0.1, 0.05)))
+            base_session.put("bot1/odom", encode_pose(ODOMETRY, (0.0, 0.0, 0.0), stamp, "odom"))
+            return robot.has_pose()
+
+        assert wait_until(lambda: instant(0, (1.0, 2.0, 0.0)))
+        assert robot.current_pose() == pytest.approx((20.0, 40.0, 0.0))
+        for step, x in enumerate((1.1, 1.3, 1.2), start=1):
+            robot.command(0.0, 0.0)
+            base.next()
+            instant(step * 10**8, (x, 2.0, 0.0))
+            assert robot.current_pose() == pytest.approx((20.0 * x, 40.0, 0.0))  # whole
         robot.close()
 
 

@@ -50,12 +50,14 @@ def test_with_noise_odometry_drifts_and_the_localisers_fixes_arrive_late_stamped
     first = bases.readings()
     assert [fix[0] for fix in first[0].fixes] == [0]  # the start pose, as an operator gives AMCL its first
     assert first[0].fixes[0][1] == pytest.approx(first[0].odometry)
+    assert first[0].start and first == bases.readings()  # exact, and so each time it is sent again for a late driver
     bases.command(0, 0.2, 0.1)
     bases.command(1, 0.2, -0.1)
     arrivals = {}
     for _ in range(12):
         readings = bases.advance()
         arrivals[bases.step] = [stamp for stamp, _ in readings[0].fixes]
+        assert not readings[0].start  # the localiser's own fixes: sent with its σ
     period = round(0.1 * NANOSECONDS)
     # Measured at steps 2, 4, 6, ...; each handed out 2 periods later, stamped with the instant it measured.
     assert arrivals[4] == [2 * period] and arrivals[6] == [4 * period] and arrivals[12] == [10 * period]

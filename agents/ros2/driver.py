@@ -89,6 +89,9 @@ class Ros2Robot:
         self._offset: Pose | None = None if options.localiser_topic else options.odom_offset  # map ← odom
         self._noise, self._metres_per_unit = noise_of(scenario), scenario.metres_per_unit
         self._variance = np.zeros((1, 2))  # the pose's doubt (scenario units², rad²): the first fix is the start
+        # A fix's covariance is weighed only against a model of the odometry's drift: without one the doubt never
+        # grows, a fix's gain would fall as 1 / n, and the localiser would be ignored; each fix is then taken whole.
+        self._weighs = self._noise.odometry_per_metre > 0.0 or self._noise.odometry_per_radian > 0.0
         self._fused_stamp: int | None = None  # the stamp of the latest fix taken: a fix sent again is not taken again
         self._stale_since: float | None = None  # control thread only: the odometry went stale then
         self._acting: Pose | None = None  # control thread only: the pose this step acts on (None: hold)
@@ -172,15 +175,15 @@ class Ros2Robot:
         """map ← odom from a fix and the odometry nearest its stamp (under the lock): the first taken whole, with
         the doubt its covariance gives (none where it gives none: the operator's initial pose, as the simulator
         sends the start); later ones by their gain against their covariance, or the scenario's σ where they give
-        none; each once (the simulator in lockstep sends an instant's readings again while it waits for commands;
-        fused twice, a fix would count as two)."""
+        none or the scenario models no odometry drift (:attr:`_weighs`); each once (the simulator in lockstep sends
+        an instant's readings again while it waits for commands; fused twice, a fix would count as two)."""
         if self._fused_stamp is not None and fix.stamp_ns <= self._fused_stamp:
             return
         self._fused_stamp = fix.stamp_ns
         _, odometry = min(self._history, key=lambda entry: abs(entry[0] - fix.stamp_ns))
         pose = fix.pose
         measured = None
-        if fix.variance is not None:  # metres² to the scenario's units²
+        if fix.variance is not None and self._weighs:  # metres² to the scenario's units²
             measured = np.array([[fix.variance[0] / self._metres_per_unit**2, fix.variance[1]]])
         if self._offset is None:
             if measured is not None:

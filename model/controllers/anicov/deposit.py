@@ -65,7 +65,8 @@ def _kept(store: dict[Any, T], key: Any, value: T, most: int) -> T:
 
 
 class Deposit:
-    """The coverage (in Λ*) a camera adds over the scenario's grid, as the engine's sensor adds it."""
+    """The coverage a camera adds over the scenario's grid, as the engine's sensor adds it, in the team map's units:
+    Λ*, or (1 + cover_margin) Λ* with noise; "in Λ*" below means in those units."""
 
     def __init__(self, scenario: Scenario, ground: Ground | None = None, period_steps: int | None = None) -> None:
         """``ground``: the world's, for stares that walls hide (the open world's if not given); ``period_steps``:
