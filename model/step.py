@@ -40,6 +40,7 @@ class LawParameters(NamedTuple):
     face_radius: float = 0.0  # the anicov controller's stations: a carrot this near is a bearing to face (0: none)
     position_doubt: float = 0.0  # how far off its belief a robot may stand: its map takes the sure coverage (0: exact)
     heading_doubt: float = 0.0  # and how far its heading may be off, radians (model.paper.sensing.sure_sensing_ability)
+    face_turn_steps: float = 1.0  # steps a robot at its station takes to turn to a bearing: 1 + its commands' delay
 
 
 @njit(cache=True)
@@ -84,7 +85,7 @@ def pursue(
     ``law``'s gains, time step and weave."""
     return pursuit_law(
         x, y, theta, objective_x, objective_y, law.k_v, law.k_omega, law.dt, law.weave_amplitude,
-        law.weave_wavelength, law.face_radius,
+        law.weave_wavelength, law.face_radius, law.face_turn_steps,
     )  # fmt: skip
 
 

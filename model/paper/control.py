@@ -84,6 +84,7 @@ def pursuit_law(
     weave_amplitude: float = 0.0,
     weave_wavelength: float = 1.0,
     face_radius: float = 0.0,
+    face_turn_steps: float = 1.0,
 ) -> tuple[float, float]:
     """Beyond the paper, the ``anicov`` controller (docs/controller.md): drive at the objective, a carrot
     on the planned path (pure pursuit, Coulter 1992), at full speed until the carrot is within one step,
@@ -100,14 +101,16 @@ def pursuit_law(
 
     A carrot nearer than ``face_radius`` (> 0; a robot at a station, :mod:`model.controllers.anicov.stations`) is a bearing to
     face, not a place to go: the robot stands (v = 0) and turns toward the carrot's bearing at the bound,
-    ω = e_θ/dt held to |ω| ≤ π k_ω (it reaches the bearing within the step where it can). With
-    ``face_radius`` = 0 (every sweep but the stations) this never applies."""
+    ω = e_θ/(s dt) held to |ω| ≤ π k_ω, s = ``face_turn_steps`` (1: it reaches the bearing within the step where it
+    can; a robot whose commands reach its wheels d steps late turns over 1 + d: turning the whole error each step, it
+    would turn it again before the first turn acted, and swing by e_θ for ever). With ``face_radius`` = 0 (every
+    sweep but the stations) this never applies."""
     dx = objective_x - x
     dy = objective_y - y
     bearing = math.atan2(dy, dx)
     if dx * dx + dy * dy < face_radius * face_radius:
         bound = math.pi * k_omega
-        return 0.0, min(bound, max(-bound, wrap_angle(bearing - theta) / dt))
+        return 0.0, min(bound, max(-bound, wrap_angle(bearing - theta) / (dt * face_turn_steps)))
     along_x = abs(dx) >= abs(dy)
     phase = 2.0 * math.pi * (x if along_x else y) / weave_wavelength
     e_theta = wrap_angle(bearing + weave_amplitude * math.sin(phase) - theta)

@@ -6,6 +6,7 @@ from __future__ import annotations
 from model.controllers.anicov.route import face_radius_of
 from model.controllers.anicov.weave import sweep_of
 from model.controllers.interface import paper_law
+from model.physics.noise import noise_of
 from model.scenario import Scenario
 from model.step import LawParameters
 
@@ -19,4 +20,5 @@ def anicov_law(scenario: Scenario, target_ticks: int) -> LawParameters:
         weave_amplitude=sweep.amplitude if sweep else 0.0,
         weave_wavelength=sweep.wavelength if sweep else 1.0,
         face_radius=face_radius_of(scenario),
+        face_turn_steps=1.0 + noise_of(scenario).command_delay,
     )
