@@ -135,34 +135,30 @@ def command_sweep_plot(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _shown(table: str, write: str | None) -> int:
+    """A study's Markdown table printed, and written to ``write`` where given."""
+    if write:
+        Path(write).write_text(table)
+    print(table, end="")
+    return EXIT_OK
+
+
 def command_controller_table(args: argparse.Namespace) -> int:
     from anicov.controller_table import controller_table
 
-    table = controller_table(Path(args.out), args.challenger)
-    if args.write:
-        Path(args.write).write_text(table)
-    print(table, end="")
-    return EXIT_OK
+    return _shown(controller_table(Path(args.out), args.challenger), args.write)
 
 
 def command_maps_table(args: argparse.Namespace) -> int:
     from anicov.maps_table import maps_table
 
-    table = maps_table([Path(out) for out in args.out], args.challenger)
-    if args.write:
-        Path(args.write).write_text(table)
-    print(table, end="")
-    return EXIT_OK
+    return _shown(maps_table([Path(out) for out in args.out], args.challenger), args.write)
 
 
 def command_physics_table(args: argparse.Namespace) -> int:
     from anicov.physics_table import physics_table
 
-    table = physics_table([Path(out) for out in args.out])
-    if args.write:
-        Path(args.write).write_text(table)
-    print(table, end="")
-    return EXIT_OK
+    return _shown(physics_table([Path(out) for out in args.out]), args.write)
 
 
 def command_router(args: argparse.Namespace) -> int:

@@ -34,8 +34,20 @@ def controller_label(name: str) -> str:
     return f"{Path(module).name}:{attribute}" if module.endswith(".py") else name
 
 
-def _mean(values: list[float]) -> float:
+def mean(values: list[float]) -> float:
+    """The mean of ``values``; NaN where there are none."""
     return sum(values) / len(values) if values else float("nan")
+
+
+def least(rows: list[dict[str, str]], key: str) -> float:
+    """The least of a figure over the runs that have it (a lone robot has no centre gap): NaN where none does."""
+    found = [float(row[key]) for row in rows if row.get(key, "") not in ("", "nan")]
+    return min(found) if found else float("nan")
+
+
+def figure(value: float, digits: int, unit: str = "") -> str:
+    """A table's cell for a figure: "—" where there is none (NaN)."""
+    return "—" if value != value else f"{value:,.{digits}f}{unit}"
 
 
 def controller_table(out_dir: Path, challenger: str = "anicov") -> str:
@@ -46,7 +58,7 @@ def controller_table(out_dir: Path, challenger: str = "anicov") -> str:
     one_robot = [float(row["team_path_length"]) for row in groups.get((1, "zigzag"), [])]
     if not one_robot:
         raise ValueError(f"{out_dir}/runs.csv: no zigzag run at N = 1, the path's yardstick")
-    yardstick = _mean(one_robot)
+    yardstick = mean(one_robot)
     header = ["N", *(f"{c} t/t*" for c in controllers), *(f"{c} path" for c in controllers), "complete"]
     if challenger in controllers:
         header += [f"{challenger} vs best other", "time goal", "path goal"]
@@ -56,8 +68,8 @@ def controller_table(out_dir: Path, challenger: str = "anicov") -> str:
         for controller in controllers:
             rows = groups.get((agents, controller), [])
             finished = [row for row in rows if row["completed"] == "True"]
-            ratio[controller] = _mean([float(row["time_ratio"]) for row in finished])
-            path[controller] = _mean([float(row["team_path_length"]) for row in rows]) / yardstick
+            ratio[controller] = mean([float(row["time_ratio"]) for row in finished])
+            path[controller] = mean([float(row["team_path_length"]) for row in rows]) / yardstick
             done, total = done + len(finished), total + len(rows)
         cells = [
             str(agents),

@@ -16,10 +16,9 @@ r is the sweep's base scenario's ``robot_radius`` (DIR/sweep.json). A goal misse
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
-from anicov.controller_table import read_runs
+from anicov.controller_table import figure, least, mean, read_runs
 
 LESS_GOAL = 0.30
 BASELINE = "paper"
@@ -29,16 +28,6 @@ HEADER = (
 )
 
 
-def _mean(values: list[float]) -> float:
-    return sum(values) / len(values) if values else math.nan
-
-
-def _least(rows: list[dict[str, str]], key: str) -> float:
-    """The least of a figure over the runs that have it (a lone robot has no centre gap): NaN where none does."""
-    found = [float(row[key]) for row in rows if row.get(key, "") not in ("", "nan")]
-    return min(found) if found else math.nan
-
-
 def _misses(rows: dict[str, list[dict[str, str]]], less: float, radius: float) -> list[str]:
     """What of the goals the runs of both controllers at one team size miss (see the module)."""
     misses = []
@@ -46,7 +35,7 @@ def _misses(rows: dict[str, list[dict[str, str]]], less: float, radius: float) -
         short = sum(row["completed"] != "True" for row in runs)
         if short:
             misses.append(f"{controller}: {short} incomplete")
-        gap, clearance = _least(runs, "min_separation"), _least(runs, "min_clearance")
+        gap, clearance = least(runs, "min_separation"), least(runs, "min_clearance")
         if gap < 2.0 * radius:
             misses.append(f"{controller}: a collision (centre gap {gap:.3f} < 2r)")
         if clearance < radius:
@@ -54,10 +43,6 @@ def _misses(rows: dict[str, list[dict[str, str]]], less: float, radius: float) -
     if not less >= LESS_GOAL:
         misses.append(f"{100 * less:.1f} % less, not {100 * LESS_GOAL:.0f} %")
     return misses
-
-
-def _figure(value: float, digits: int) -> str:
-    return "—" if math.isnan(value) else f"{value:,.{digits}f}"
 
 
 def map_rows(out_dir: Path, challenger: str = "anicov") -> list[str]:
@@ -70,10 +55,9 @@ def map_rows(out_dir: Path, challenger: str = "anicov") -> list[str]:
         if not all(rows.values()):
             continue  # a team size one controller has no run of is no comparison
         times = {
-            c: _mean([float(r["completion_time"]) for r in runs if r["completed"] == "True"])
-            for c, runs in rows.items()
+            c: mean([float(r["completion_time"]) for r in runs if r["completed"] == "True"]) for c, runs in rows.items()
         }
-        paths = {c: _mean([float(r["team_path_length"]) for r in runs]) for c, runs in rows.items()}
+        paths = {c: mean([float(r["team_path_length"]) for r in runs]) for c, runs in rows.items()}
         done = {c: sum(r["completed"] == "True" for r in runs) for c, runs in rows.items()}
         less = 1.0 - times[challenger] / times[BASELINE]
         mine = rows[challenger]
@@ -81,12 +65,12 @@ def map_rows(out_dir: Path, challenger: str = "anicov") -> list[str]:
         cells = [
             out_dir.name,
             str(agents),
-            _figure(times[challenger], 1),
-            _figure(times[BASELINE], 1),
+            figure(times[challenger], 1),
+            figure(times[BASELINE], 1),
             f"{100 * less:.1f} %",
             f"{done[challenger]} / {len(mine)}, {done[BASELINE]} / {len(rows[BASELINE])}",
-            f"{_figure(paths[challenger], 0)} / {_figure(paths[BASELINE], 0)}",
-            f"{_figure(_least(mine, 'min_separation'), 3)} / {_figure(_least(mine, 'min_clearance'), 3)}",
+            f"{figure(paths[challenger], 0)} / {figure(paths[BASELINE], 0)}",
+            f"{figure(least(mine, 'min_separation'), 3)} / {figure(least(mine, 'min_clearance'), 3)}",
             "met" if not misses else "missed: " + "; ".join(misses),
         ]
         lines.append("| " + " | ".join(cells) + " |")

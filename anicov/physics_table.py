@@ -25,7 +25,7 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
-from anicov.controller_table import read_runs
+from anicov.controller_table import figure, least, mean, read_runs
 from model.scenario.physics_keys import RULES
 
 TRUE_COVERAGE_GOAL = 0.995
@@ -70,13 +70,7 @@ def collect(out_dirs: list[Path]) -> dict[str, dict[tuple[int, str], Runs]]:
 
 
 def _mean_time(runs: list[dict[str, str]]) -> float:
-    times = [float(row["completion_time"]) for row in runs if row["completed"] == "True"]
-    return sum(times) / len(times) if times else math.nan
-
-
-def _least(runs: list[dict[str, str]], key: str) -> float:
-    found = [float(row[key]) for row in runs if row.get(key, "") not in ("", "nan")]
-    return min(found) if found else math.nan
+    return mean([float(row["completion_time"]) for row in runs if row["completed"] == "True"])
 
 
 def _contacts(runs: list[dict[str, str]]) -> int:
@@ -99,9 +93,9 @@ def misses(runs: Runs) -> list[str]:
             found.append(f"{mode}: {contacts} contacts")
         if unjudged := sum(row.get("true_coverage", "") in ("", "nan") for row in rows):
             found.append(f"{mode}: {unjudged} runs without a true coverage")
-        least = _least(rows, "true_coverage")
-        if least < TRUE_COVERAGE_GOAL:
-            found.append(f"{mode}: true coverage {100 * least:.2f} % < {100 * TRUE_COVERAGE_GOAL:.1f} %")
+        lowest = least(rows, "true_coverage")
+        if lowest < TRUE_COVERAGE_GOAL:
+            found.append(f"{mode}: true coverage {100 * lowest:.2f} % < {100 * TRUE_COVERAGE_GOAL:.1f} %")
         if math.isnan(kinematic):
             found.append(f"{mode}: no complete kinematic run to time it against")
             continue
@@ -109,10 +103,6 @@ def misses(runs: Runs) -> list[str]:
         if more > TIME_GOAL:
             found.append(f"{mode}: {100 * more:+.1f} % over kinematic, not within {100 * TIME_GOAL:.0f} %")
     return found
-
-
-def _figure(value: float, digits: int, unit: str = "") -> str:
-    return "—" if math.isnan(value) else f"{value:,.{digits}f}{unit}"
 
 
 def _pair(runs: Runs, mode: str, kinematic: float) -> str:
@@ -131,14 +121,14 @@ def row_cells(name: str, agents: int, controller: str, runs: Runs) -> list[str]:
     )
     contacts = " / ".join(str(_contacts(runs[mode])) if runs.get(mode) else "—" for mode in ("physics", "noise"))
     coverage = " / ".join(
-        _figure(100 * _least(runs.get(mode, []), "true_coverage"), 2, " %") for mode in ("physics", "noise")
+        figure(100 * least(runs.get(mode, []), "true_coverage"), 2, " %") for mode in ("physics", "noise")
     )
     missed = misses(runs)
     return [
         name,
         str(agents),
         controller,
-        _figure(kinematic, 1),
+        figure(kinematic, 1),
         _pair(runs, "physics", kinematic),
         _pair(runs, "noise", kinematic),
         done,
