@@ -287,17 +287,20 @@ def _sure_seer(
     seers = [s for s in world.seers_of((col + 0.5) * cell, (row + 0.5) * cell)[:, 1:] if cell_of(s, cell) not in banned]
     ways = np.array([(0.0, 0.0), *((np.cos(a), np.sin(a)) for a in np.arange(8) * np.pi / 4)])
     ground = world.ground
-    for spread in SEER_SPREADS:
-        for seer in seers[:SEERS_TRIED]:
-            for way in ways:
-                station = seer + SHIFT_SPREADS * face * way
-                if not in_reachable_cell(world.reachable, *station, scenario.cell):
-                    continue  # a wide face radius (a noisy localiser's) shifts it off the team's space: no path goes there
-                if not in_sight(ground.wall_grid, *seer, *station, ground.grain, ground.plan_radius, ground.bounded):
-                    continue  # the disk with its clearance does not fit there: the filter would hold it short
-                stares = deposit.sure_stares(station[None, :], ANGLES, spread * face)
-                if stares[flat].sum() > 0.0:
-                    return station, stares
+    stations = []
+    for seer in seers[:SEERS_TRIED]:
+        for way in ways:
+            station = seer + SHIFT_SPREADS * face * way
+            if not in_reachable_cell(world.reachable, *station, scenario.cell):
+                continue  # a wide face radius (a noisy localiser's) shifts it off the team's space: no path goes there
+            if not in_sight(ground.wall_grid, *seer, *station, ground.grain, ground.plan_radius, ground.bounded):
+                continue  # the disk with its clearance does not fit there: the filter would hold it short
+            stations.append(station)
+    for spread in SEER_SPREADS:  # the places tried once, over each spread in turn
+        for station in stations:
+            stares = deposit.sure_stares(station[None, :], ANGLES, spread * face)
+            if stares[flat].sum() > 0.0:
+                return station, stares
     return None
 
 
