@@ -170,9 +170,12 @@ class LanePlanner(TeamPlanner):
         elif free:
             self._give_passes(lack, positions, ids, free)
         face, arrive = face_radius_of(self.scenario), arrive_radius_of(self.scenario)
+        held = {} if self.flight is None else self.flight.held  # robots waiting their turn at a station
         targets = np.array(
             [
-                self.routes[agent].carrot(positions[index], self.lookahead, face, arrive)
+                held[agent]
+                if agent in held
+                else self.routes[agent].carrot(positions[index], self.lookahead, face, arrive)
                 for index, agent in enumerate(ids)
             ],
             dtype=np.float64,

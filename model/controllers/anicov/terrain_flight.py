@@ -12,6 +12,8 @@ programmes).
   station, on what the others will not stare at; a robot given nothing stays. A cleanup route flown to its
   end that took less than :data:`CLEANUP_PROGRESS` of its cells' Υ has its stations banned from later
   cleanups (the robot could not stand or face as the stares assume), so that no robot is sent there for ever.
+- **Turns** (:mod:`model.controllers.anicov.terrain_turns`): of two robots whose next stations are too near for both
+  to stand there, the one farther from its own waits (:attr:`TerrainFlight.held` has its carrot).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from model.controllers.anicov.deposit import Deposit
-from model.controllers.anicov.route import Route, Stop, arrive_radius_of
+from model.controllers.anicov.route import Route, Stop, arrive_radius_of, face_radius_of
 from model.controllers.anicov.terrain_cleanup import (
     cell_of,
     cleanup_pieces,
@@ -34,6 +36,7 @@ from model.controllers.anicov.terrain_cleanup import (
 from model.controllers.anicov.terrain_lanes import free_path, piece_route
 from model.controllers.anicov.terrain_relief import aside, in_the_way, relief
 from model.controllers.anicov.terrain_stations import ANGLES, deposit_among_walls
+from model.controllers.anicov.terrain_turns import next_station, station_gap, wait_carrot, who_waits
 from model.scenario import Scenario
 from model.scenario.physics_keys import pair_margin_of
 from model.world.world import world_of
@@ -61,6 +64,7 @@ class TerrainFlight:
     cleanup_wait: int = 0
     cleaning: dict[int, tuple[list[tuple[int, int]], np.ndarray, float]] = field(default_factory=dict)
     banned: set[tuple[int, int]] = field(default_factory=set)
+    held: dict[int, np.ndarray] = field(default_factory=dict)  # this plan's carrot of each robot that waits its turn
 
     def steer(
         self, routes: dict[int, Route], lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]
@@ -74,6 +78,7 @@ class TerrainFlight:
                     self.patch(routes, agent, lack)
         self.clean_up(routes, lack, positions, ids, free)
         self.make_way(routes, positions, ids)
+        self.take_turns(routes, positions, ids)
         for agent in ids:
             route = routes[agent]
             self.stops_left[agent] = len(route.stops)
@@ -95,6 +100,16 @@ class TerrainFlight:
             place = aside(world, positions[index], busy, gap)
             if place is not None:
                 routes[agent] = Route.of(free_path(world, positions[index], place), cleanup=True)
+
+    def take_turns(self, routes: dict[int, Route], positions: np.ndarray, ids: list[int]) -> None:
+        """Who waits for a teammate's station this plan, and where (:mod:`terrain_turns`): :attr:`held`."""
+        scenario = self.scenario
+        gap, face = station_gap(scenario), face_radius_of(scenario)
+        self.held = {}
+        for index, first in who_waits(routes, positions, ids, gap).items():
+            agent = ids[index]
+            blockers = [next_station(routes[ids[other]]) for other in first]
+            self.held[agent] = wait_carrot(routes[agent], positions[index], blockers, gap, face, 0.5 * scenario.cell)
 
     def patch(self, routes: dict[int, Route], agent: int, lack: np.ndarray) -> None:
         """The robot has just faced its station's last bearing: a stop where it stands with the bearings that

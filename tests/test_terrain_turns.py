@@ -1,0 +1,80 @@
+"""model.controllers.anicov.terrain_turns: of two robots whose next stations are too near for both, the one
+nearer its own goes first and the other waits out of the way, facing its station; far apart, nobody waits. And the
+lab run that two such pairs held to the end now completes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from anicov.engine import run_scenario
+from model.controllers.anicov.route import Route, Stop, face_radius_of
+from model.controllers.anicov.terrain_turns import station_gap, wait_carrot, who_waits
+from model.scenario import load_scenario
+from model.scenario.physics_keys import pair_margin_of
+from tests.test_real_maps import REAL, map_of
+from tests.test_terrain_stations import ROOMS
+
+
+def route_to(start: list[float], station: list[float]) -> Route:
+    """A straight route from ``start`` to a station at its end, with one bearing to face there."""
+    points = np.array([start, station], dtype=np.float64)
+    length = float(np.hypot(*(points[1] - points[0])))
+    return Route.of(points, stops=[Stop(length, [0.0])])
+
+
+def test_the_gap_lets_both_look_ahead_points_swing_clear_of_each_other():
+    gap = station_gap(ROOMS)
+    assert gap == pytest.approx(2 * ROOMS.robot_radius + pair_margin_of(ROOMS) + 4 * ROOMS.lookahead)
+    # Two centres the gap apart, look-ahead points turned straight at each other: the filter's pair clearance is left.
+    assert gap - 2 * ROOMS.lookahead == pytest.approx(2 * ROOMS.robot_radius + pair_margin_of(ROOMS) + 2 * ROOMS.lookahead)
+
+
+def test_the_robot_farther_from_its_station_waits_for_the_nearer_one():
+    gap = station_gap(ROOMS)
+    routes = {0: route_to([4.5, 2.5], [6.5, 8.5]), 1: route_to([6.5, 7.5], [6.5, 9.0])}
+    positions = np.array([[4.5, 2.5], [6.5, 7.5]])
+    assert who_waits(routes, positions, [0, 1], gap) == {0: [1]}  # robot 1 is 1.5 from its station, robot 0 6.3
+    assert who_waits(routes, positions[::-1].copy(), [1, 0], gap) == {1: [0]}  # indices follow ids' order
+
+
+def test_a_tie_goes_to_the_lower_id_and_stations_far_apart_keep_everyone_going():
+    gap = station_gap(ROOMS)
+    tied = {3: route_to([6.5, 4.5], [6.5, 8.5]), 5: route_to([6.5, 13.0], [6.5, 9.0])}
+    assert who_waits(tied, np.array([[6.5, 4.5], [6.5, 13.0]]), [3, 5], gap) == {1: [0]}
+    apart = {0: route_to([4.5, 2.5], [6.5, 8.5]), 1: route_to([6.5, 7.5], [6.5, 8.5 + gap + 0.01])}
+    assert who_waits(apart, np.array([[4.5, 2.5], [6.5, 7.5]]), [0, 1], gap) == {}
+    no_stop = {0: route_to([4.5, 2.5], [6.5, 8.5]), 1: Route.of(np.array([[6.5, 8.6]]), cleanup=True)}
+    assert who_waits(no_stop, np.array([[4.5, 2.5], [6.5, 8.6]]), [0, 1], gap) == {}  # standing idle: make_way's
+
+
+def test_a_robot_clear_of_the_station_stands_and_faces_its_own():
+    gap, face = station_gap(ROOMS), face_radius_of(ROOMS)
+    route = route_to([4.5, 2.5], [6.5, 8.5])
+    position = np.array([5.0, 4.0])
+    carrot = wait_carrot(route, position, [np.array([6.5, 9.0])], gap, face, 0.5)
+    assert np.hypot(*(carrot - position)) == pytest.approx(0.5 * face)  # nearer than the face radius: stand
+    toward = np.array([6.5, 8.5]) - position
+    assert np.dot(carrot - position, toward) == pytest.approx(0.5 * face * np.hypot(*toward))
+
+
+def test_a_robot_inside_the_gap_backs_off_along_the_way_it_came():
+    gap, face = station_gap(ROOMS), face_radius_of(ROOMS)
+    route = route_to([6.5, 2.5], [6.5, 8.5])
+    route.progress = 5.5  # at (6.5, 8.0), beside the teammate's station at (6.5, 9.0)
+    blocker = np.array([6.5, 9.0])
+    carrot = wait_carrot(route, route.point_at(route.progress), [blocker], gap, face, 0.5)
+    assert carrot[0] == pytest.approx(6.5) and carrot[1] < 8.0  # back down the route
+    assert np.hypot(*(carrot - blocker)) >= gap
+    assert np.hypot(*(carrot - blocker)) < gap + 0.5  # the nearest such point, at the spacing
+
+
+def test_the_lab_run_two_pairs_of_neighbouring_stations_held_now_completes():
+    """The MRPT lab, N = 10, seed 4, kinematic: two robots drove at stations 0.2 m from stations teammates stood at
+    from t = 50 on, the filter held both of each pair (400 deadlocks) and the watchdog gave a cell up (not complete,
+    9,360 steps). With turns: complete at 311.2, no deadlock."""
+    scenario_path = REAL / "uwb-lab.toml"
+    map_of(scenario_path)
+    scenario = load_scenario(scenario_path).with_overrides(agents=10, seed=4, controller="anicov", max_time=1500.0)
+    result = run_scenario(scenario, record_trace=False)
+    assert result.completed and not result.given_up.any()
