@@ -30,22 +30,27 @@ def test_the_gap_lets_both_look_ahead_points_swing_clear_of_each_other():
     assert gap - 2 * ROOMS.lookahead == pytest.approx(2 * ROOMS.robot_radius + pair_margin_of(ROOMS) + 2 * ROOMS.lookahead)
 
 
-def test_the_robot_farther_from_its_station_waits_for_the_nearer_one():
+APPROACH = ROOMS.k_v * 0.5  # a plan period's way
+
+
+def test_the_robot_farther_from_its_station_waits_for_the_nearer_one_once_it_comes_near():
     gap = station_gap(ROOMS)
-    routes = {0: route_to([4.5, 2.5], [6.5, 8.5]), 1: route_to([6.5, 7.5], [6.5, 9.0])}
-    positions = np.array([[4.5, 2.5], [6.5, 7.5]])
-    assert who_waits(routes, positions, [0, 1], gap) == {0: [1]}  # robot 1 is 1.5 from its station, robot 0 6.3
-    assert who_waits(routes, positions[::-1].copy(), [1, 0], gap) == {1: [0]}  # indices follow ids' order
+    routes = {0: route_to([6.5, 4.0], [6.5, 8.5]), 1: route_to([6.5, 10.5], [6.5, 9.0])}
+    near = np.array([[6.5, 9.0 - gap - 0.5 * APPROACH], [6.5, 10.5]])  # robot 0 enters the gap in this period
+    assert who_waits(routes, near, [0, 1], gap, APPROACH) == {0: [1]}  # robot 1 is 1.5 from its station
+    assert who_waits(routes, near[::-1].copy(), [1, 0], gap, APPROACH) == {1: [0]}  # indices follow ids' order
+    far = np.array([[6.5, 9.0 - gap - 1.5 * APPROACH], [6.5, 10.5]])  # robot 1 may be gone when it comes
+    assert who_waits(routes, far, [0, 1], gap, APPROACH) == {}
 
 
 def test_a_tie_goes_to_the_lower_id_and_stations_far_apart_keep_everyone_going():
     gap = station_gap(ROOMS)
-    tied = {3: route_to([6.5, 4.5], [6.5, 8.5]), 5: route_to([6.5, 13.0], [6.5, 9.0])}
-    assert who_waits(tied, np.array([[6.5, 4.5], [6.5, 13.0]]), [3, 5], gap) == {1: [0]}
-    apart = {0: route_to([4.5, 2.5], [6.5, 8.5]), 1: route_to([6.5, 7.5], [6.5, 8.5 + gap + 0.01])}
-    assert who_waits(apart, np.array([[4.5, 2.5], [6.5, 7.5]]), [0, 1], gap) == {}
-    no_stop = {0: route_to([4.5, 2.5], [6.5, 8.5]), 1: Route.of(np.array([[6.5, 8.6]]), cleanup=True)}
-    assert who_waits(no_stop, np.array([[4.5, 2.5], [6.5, 8.6]]), [0, 1], gap) == {}  # standing idle: make_way's
+    tied = {3: route_to([6.5, 7.0], [6.5, 8.5]), 5: route_to([6.5, 10.5], [6.5, 9.0])}
+    assert who_waits(tied, np.array([[6.5, 7.0], [6.5, 10.5]]), [3, 5], gap, APPROACH) == {1: [0]}
+    apart = {0: route_to([6.5, 7.0], [6.5, 8.5]), 1: route_to([6.5, 10.5], [6.5, 8.5 + gap + 0.01])}
+    assert who_waits(apart, np.array([[6.5, 7.0], [6.5, 10.5]]), [0, 1], gap, APPROACH) == {}
+    no_stop = {0: route_to([6.5, 7.0], [6.5, 8.5]), 1: Route.of(np.array([[6.5, 8.6]]), cleanup=True)}
+    assert who_waits(no_stop, np.array([[6.5, 7.0], [6.5, 8.6]]), [0, 1], gap, APPROACH) == {}  # idle: make_way's
 
 
 def test_a_robot_clear_of_the_station_stands_and_faces_its_own():
@@ -72,7 +77,7 @@ def test_a_robot_inside_the_gap_backs_off_along_the_way_it_came():
 def test_the_lab_run_two_pairs_of_neighbouring_stations_held_now_completes():
     """The MRPT lab, N = 10, seed 4, kinematic: two robots drove at stations 0.2 m from stations teammates stood at
     from t = 50 on, the filter held both of each pair (400 deadlocks) and the watchdog gave a cell up (not complete,
-    9,360 steps). With turns: complete at 311.2, no deadlock."""
+    9,360 steps). With turns: complete, no deadlock."""
     scenario_path = REAL / "uwb-lab.toml"
     map_of(scenario_path)
     scenario = load_scenario(scenario_path).with_overrides(agents=10, seed=4, controller="anicov", max_time=1500.0)

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from model.controllers.anicov.deposit import Deposit
-from model.controllers.anicov.route import Route, Stop, arrive_radius_of, face_radius_of
+from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop, arrive_radius_of, face_radius_of
 from model.controllers.anicov.terrain_cleanup import (
     cell_of,
     cleanup_pieces,
@@ -106,7 +106,8 @@ class TerrainFlight:
         scenario = self.scenario
         gap, face = station_gap(scenario), face_radius_of(scenario)
         self.held = {}
-        for index, first in who_waits(routes, positions, ids, gap).items():
+        approach = scenario.k_v * CARROT_PERIOD
+        for index, first in who_waits(routes, positions, ids, gap, approach).items():
             agent = ids[index]
             blockers = [next_station(routes[ids[other]]) for other in first]
             self.held[agent] = wait_carrot(routes[agent], positions[index], blockers, gap, face, 0.5 * scenario.cell)

@@ -9,8 +9,9 @@ lab, N = 10, seed 4, kinematic: two such pairs from t = 50 to the end, 400 deadl
 N = 10, seed 1, physics: about 15 time units).
 
 - **Who waits** (:func:`who_waits`): a robot whose next station is within the gap of a teammate's next station
-  waits when that teammate is nearer its own (ties: the lower id goes first). The nearest robot of every such
-  group goes, so some robot always goes.
+  waits when that teammate is nearer its own (ties: the lower id goes first), once it would come within the gap of
+  the teammate's station in the coming plan period; farther off it flies on, as the teammate may be gone by the
+  time it arrives. The nearest robot of every such group goes, so some robot always goes.
 - **Where it waits** (:func:`wait_carrot`): where it stands, facing its station, when it is at least the gap from
   every station it waits for; else back along its own route (a way it has come, so free) to the nearest point
   that far; where there is none, where it stands.
@@ -42,8 +43,11 @@ def next_station(route: Route) -> np.ndarray | None:
     return route.point_at(route.stops[0].at) if route.stops else None
 
 
-def who_waits(routes: dict[int, Route], positions: np.ndarray, ids: list[int], gap: float) -> dict[int, list[int]]:
-    """For each robot (index into ``ids``) that waits, the indices of the robots it waits for (see the module)."""
+def who_waits(
+    routes: dict[int, Route], positions: np.ndarray, ids: list[int], gap: float, approach: float
+) -> dict[int, list[int]]:
+    """For each robot (index into ``ids``) that waits, the indices of the robots it waits for (see the module):
+    ``approach`` is how far a robot goes in a plan period."""
     stations = {index: next_station(routes[agent]) for index, agent in enumerate(ids)}
     ahead = {index: place for index, place in stations.items() if place is not None}
     distance = {index: float(np.hypot(*(place - positions[index]))) for index, place in ahead.items()}
@@ -54,6 +58,7 @@ def who_waits(routes: dict[int, Route], positions: np.ndarray, ids: list[int], g
             for other, there in ahead.items()
             if other != index
             and float(np.hypot(*(there - place))) < gap
+            and float(np.hypot(*(there - positions[index]))) < gap + approach
             and (distance[other], ids[other]) < (distance[index], ids[index])
         ]
         if first:
