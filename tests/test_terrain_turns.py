@@ -27,7 +27,9 @@ def test_the_gap_lets_both_look_ahead_points_swing_clear_of_each_other():
     gap = station_gap(ROOMS)
     assert gap == pytest.approx(2 * ROOMS.robot_radius + pair_margin_of(ROOMS) + 4 * ROOMS.lookahead)
     # Two centres the gap apart, look-ahead points turned straight at each other: the filter's pair clearance is left.
-    assert gap - 2 * ROOMS.lookahead == pytest.approx(2 * ROOMS.robot_radius + pair_margin_of(ROOMS) + 2 * ROOMS.lookahead)
+    assert gap - 2 * ROOMS.lookahead == pytest.approx(
+        2 * ROOMS.robot_radius + pair_margin_of(ROOMS) + 2 * ROOMS.lookahead
+    )
 
 
 APPROACH = ROOMS.k_v * 0.5  # a plan period's way
