@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from anicov.engine import run_scenario
-from model.controllers.anicov.route import Route, Stop, face_radius_of
+from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop, face_radius_of
 from model.controllers.anicov.terrain_turns import station_gap, wait_carrot, who_waits
 from model.scenario import load_scenario
 from model.scenario.physics_keys import pair_margin_of
@@ -32,27 +32,47 @@ def test_the_gap_lets_both_look_ahead_points_swing_clear_of_each_other():
     )
 
 
-APPROACH = ROOMS.k_v * 0.5  # a plan period's way
+APPROACH = ROOMS.k_v * CARROT_PERIOD  # a plan period's way
+SPACING = 0.5 * ROOMS.cell
 
 
 def test_the_robot_farther_from_its_station_waits_for_the_nearer_one_once_it_comes_near():
     gap = station_gap(ROOMS)
     routes = {0: route_to([6.5, 4.0], [6.5, 8.5]), 1: route_to([6.5, 10.5], [6.5, 9.0])}
     near = np.array([[6.5, 9.0 - gap - 0.5 * APPROACH], [6.5, 10.5]])  # robot 0 enters the gap in this period
-    assert who_waits(routes, near, [0, 1], gap, APPROACH) == {0: [1]}  # robot 1 is 1.5 from its station
-    assert who_waits(routes, near[::-1].copy(), [1, 0], gap, APPROACH) == {1: [0]}  # indices follow ids' order
+    routes[0].progress = near[0, 1] - 4.0
+    assert who_waits(routes, near, [0, 1], gap, APPROACH, SPACING) == {0: [1]}  # robot 1 has 1.5 of its way left
+    assert who_waits(routes, near[::-1].copy(), [1, 0], gap, APPROACH, SPACING) == {1: [0]}  # indices follow ids' order
     far = np.array([[6.5, 9.0 - gap - 1.5 * APPROACH], [6.5, 10.5]])  # robot 1 may be gone when it comes
-    assert who_waits(routes, far, [0, 1], gap, APPROACH) == {}
+    routes[0].progress = far[0, 1] - 4.0
+    assert who_waits(routes, far, [0, 1], gap, APPROACH, SPACING) == {}
 
 
 def test_a_tie_goes_to_the_lower_id_and_stations_far_apart_keep_everyone_going():
     gap = station_gap(ROOMS)
     tied = {3: route_to([6.5, 7.0], [6.5, 8.5]), 5: route_to([6.5, 10.5], [6.5, 9.0])}
-    assert who_waits(tied, np.array([[6.5, 7.0], [6.5, 10.5]]), [3, 5], gap, APPROACH) == {1: [0]}
+    assert who_waits(tied, np.array([[6.5, 7.0], [6.5, 10.5]]), [3, 5], gap, APPROACH, SPACING) == {1: [0]}
     apart = {0: route_to([6.5, 7.0], [6.5, 8.5]), 1: route_to([6.5, 10.5], [6.5, 8.5 + gap + 0.01])}
-    assert who_waits(apart, np.array([[6.5, 7.0], [6.5, 10.5]]), [0, 1], gap, APPROACH) == {}
+    assert who_waits(apart, np.array([[6.5, 7.0], [6.5, 10.5]]), [0, 1], gap, APPROACH, SPACING) == {}
     no_stop = {0: route_to([6.5, 7.0], [6.5, 8.5]), 1: Route.of(np.array([[6.5, 8.6]]), cleanup=True)}
-    assert who_waits(no_stop, np.array([[6.5, 7.0], [6.5, 8.6]]), [0, 1], gap, APPROACH) == {}  # idle: make_way's
+    assert who_waits(no_stop, np.array([[6.5, 7.0], [6.5, 8.6]]), [0, 1], gap, APPROACH, SPACING) == {}  # idle: make_way's
+
+
+def test_the_way_left_ranks_them_and_a_robot_on_the_other_s_way_does_not_wait_there():
+    gap = station_gap(ROOMS)
+    # Robot 1 is nearer its station in a straight line (1.5 against 2.5); round the block it has 7.5 left, robot 0 2.5.
+    around = Route.of(np.array([[14.0, 10.0], [17.0, 10.0], [17.0, 8.5], [14.0, 8.5]]), stops=[Stop(7.5, [0.0])])
+    routes = {0: route_to([14.0, 5.0], [14.0, 7.5]), 1: around}
+    positions = np.array([[14.0, 5.0], [14.0, 10.0]])
+    assert who_waits(routes, positions, [0, 1], gap, 10.0, SPACING) == {1: [0]}
+    # Robot 0 stands on robot 1's way up the corridor; robot 1 has less left, but robot 0 does not wait there.
+    detour = Route.of(np.array([[6.5, 6.0], [3.0, 6.0], [3.0, 9.0], [6.0, 9.0]]), stops=[Stop(9.5, [0.0])])
+    routes = {0: detour, 1: route_to([6.5, 4.0], [6.5, 9.5])}
+    positions = np.array([[6.5, 6.0], [6.5, 4.0]])
+    assert who_waits(routes, positions, [0, 1], gap, 10.0, SPACING) == {}
+    positions[0] = [3.0, 6.1]  # off its way, 5.9 left against 5.5: now it waits
+    routes[0].progress = 3.6
+    assert who_waits(routes, positions, [0, 1], gap, 10.0, SPACING) == {0: [1]}
 
 
 def test_a_robot_clear_of_the_station_stands_and_faces_its_own():
@@ -71,9 +91,11 @@ def test_a_robot_inside_the_gap_backs_off_along_the_way_it_came():
     route.progress = 5.5  # at (6.5, 8.0), beside the teammate's station at (6.5, 9.0)
     blocker = np.array([6.5, 9.0])
     carrot = wait_carrot(route, route.point_at(route.progress), [blocker], gap, face, 0.5)
-    assert carrot[0] == pytest.approx(6.5) and carrot[1] < 8.0  # back down the route
-    assert np.hypot(*(carrot - blocker)) >= gap
-    assert np.hypot(*(carrot - blocker)) < gap + 0.5  # the nearest such point, at the spacing
+    assert carrot[0] == pytest.approx(6.5) and carrot[1] == pytest.approx(8.0 - 0.5)  # a step back down the route
+    route.progress = 5.5  # advance never goes back: standing at (6.5, 7.3) now, inside the gap still
+    carrot = wait_carrot(route, np.array([6.5, 7.3]), [blocker], gap, face, 0.5)
+    assert np.hypot(*(carrot - blocker)) >= gap and carrot[1] < 7.3  # the last step, to the nearest clear point
+    assert np.hypot(*(carrot - blocker)) < gap + 0.5
 
 
 def test_the_lab_run_two_pairs_of_neighbouring_stations_held_now_completes():

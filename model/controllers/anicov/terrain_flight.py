@@ -13,7 +13,8 @@ programmes).
   end that took less than :data:`CLEANUP_PROGRESS` of its cells' Υ has its stations banned from later
   cleanups (the robot could not stand or face as the stares assume), so that no robot is sent there for ever.
 - **Turns** (:mod:`model.controllers.anicov.terrain_turns`): of two robots whose next stations are too near for both
-  to stand there, the one farther from its own waits (:attr:`TerrainFlight.held` has its carrot).
+  to stand there, the one with more of its way left waits once it comes near (:attr:`TerrainFlight.held` has its
+  carrot).
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ from model.controllers.anicov.terrain_cleanup import (
 from model.controllers.anicov.terrain_lanes import free_path, piece_route
 from model.controllers.anicov.terrain_relief import aside, in_the_way, relief
 from model.controllers.anicov.terrain_stations import ANGLES, deposit_among_walls
-from model.controllers.anicov.terrain_turns import next_station, station_gap, wait_carrot, who_waits
+from model.controllers.anicov.terrain_turns import MOST_WAIT_PLANS, next_station, station_gap, wait_carrot, who_waits
 from model.scenario import Scenario
 from model.scenario.physics_keys import pair_margin_of
 from model.world.world import world_of
@@ -53,7 +54,7 @@ CLEANUP_PROGRESS = 0.1
 class TerrainFlight:
     """The state of the flight among walls: how many stops each robot had at the last plan and the bearing it
     was given then, the robots standing with nothing to do, the plans until the cleanup is tried again, each
-    cleaning robot's (station cells, cells its stares reach, their Υ when given), and the banned cells."""
+    cleaning robot's (station cells, cells its stares reach, their Υ when given), the banned cells, and who waits its turn at a station (:meth:`TerrainFlight.take_turns`)."""
 
     scenario: Scenario
     stops_left: dict[int, int] = field(default_factory=dict)
@@ -65,11 +66,13 @@ class TerrainFlight:
     cleaning: dict[int, tuple[list[tuple[int, int]], np.ndarray, float]] = field(default_factory=dict)
     banned: set[tuple[int, int]] = field(default_factory=set)
     held: dict[int, np.ndarray] = field(default_factory=dict)  # this plan's carrot of each robot that waits its turn
+    waited: dict[int, int] = field(default_factory=dict)  # plans in a row each robot has waited its turn
 
     def steer(
         self, routes: dict[int, Route], lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]
     ) -> None:
-        """Before this plan's carrots (after every route's advance): patches, then the cleanup."""
+        """Before this plan's carrots (after every route's advance): patches, the cleanup, robots with nothing to do
+        stepping aside, then who waits its turn at a station."""
         for agent in ids:
             route = routes[agent]
             if not route.cleanup and len(route.stops) < self.stops_left.get(agent, 0):
@@ -102,15 +105,21 @@ class TerrainFlight:
                 routes[agent] = Route.of(free_path(world, positions[index], place), cleanup=True)
 
     def take_turns(self, routes: dict[int, Route], positions: np.ndarray, ids: list[int]) -> None:
-        """Who waits for a teammate's station this plan, and where (:mod:`terrain_turns`): :attr:`held`."""
+        """Who waits for a teammate's station this plan, and where (:mod:`terrain_turns`): :attr:`held`; a robot
+        that has waited :data:`terrain_turns.MOST_WAIT_PLANS` plans in a row goes on until it waits no more."""
         scenario = self.scenario
-        gap, face = station_gap(scenario), face_radius_of(scenario)
+        gap, face, approach = station_gap(scenario), face_radius_of(scenario), scenario.k_v * CARROT_PERIOD
+        waits = who_waits(routes, positions, ids, gap, approach, 0.5 * scenario.cell)
         self.held = {}
-        approach = scenario.k_v * CARROT_PERIOD
-        for index, first in who_waits(routes, positions, ids, gap, approach).items():
-            agent = ids[index]
-            blockers = [next_station(routes[ids[other]]) for other in first]
-            self.held[agent] = wait_carrot(routes[agent], positions[index], blockers, gap, face, 0.5 * scenario.cell)
+        for index, agent in enumerate(ids):
+            if index not in waits:
+                self.waited.pop(agent, None)
+                continue
+            self.waited[agent] = self.waited.get(agent, 0) + 1
+            if self.waited[agent] > MOST_WAIT_PLANS:
+                continue
+            blockers = [next_station(routes[ids[other]]) for other in waits[index]]
+            self.held[agent] = wait_carrot(routes[agent], positions[index], blockers, gap, face, approach)
 
     def patch(self, routes: dict[int, Route], agent: int, lack: np.ndarray) -> None:
         """The robot has just faced its station's last bearing: a stop where it stands with the bearings that

@@ -9,11 +9,15 @@ lab, N = 10, seed 4, kinematic: two such pairs from t = 50 to the end, 400 deadl
 N = 10, seed 1, physics: about 15 time units).
 
 - **Who waits** (:func:`who_waits`): a robot whose next station is within the gap of a teammate's next station
-  waits when that teammate is nearer its own (ties: the lower id goes first), once it would come within the gap of
-  the teammate's station in the coming plan period; farther off it flies on, as the teammate may be gone by the
-  time it arrives. The nearest robot of every such group goes, so some robot always goes.
+  waits when that teammate has less of its route left to its own (ties: the lower id goes first), once it would come
+  within the gap of the teammate's station in the coming plan period; farther off it flies on, as the teammate may
+  be gone by the time it arrives. The way left along the route, not the straight line, ranks them: it never grows,
+  so two robots round a pillar do not swap. A robot standing on the teammate's way to its station does not wait
+  there: it would hold the teammate it waits for. The first robot of every such group goes, so some robot always
+  goes; and a robot waits at most :data:`MOST_WAIT_PLANS` plans in a row (two planners that differ about a teammate,
+  with a limited radio, could each make their own robot wait).
 - **Where it waits** (:func:`wait_carrot`): where it stands, facing its station, when it is at least the gap from
-  every station it waits for; else back along its own route (a way it has come, so free) to the nearest point
+  every station it waits for; else back along its own route, a plan period's way at a time, to the nearest point
   that far; where there is none, where it stands.
 
 The rule is the planner's, pure, so the coordinator's carrots are the engine's; it changes nothing where no two
@@ -27,8 +31,13 @@ import math
 import numpy as np
 
 from model.controllers.anicov.route import Route
+from model.controllers.anicov.terrain_relief import in_the_way
 from model.scenario import Scenario
 from model.scenario.physics_keys import pair_margin_of
+
+MOST_WAIT_PLANS = 120
+"""The most plans in a row a robot waits its turn (60 time units): longer than a teammate's longest cleanup station
+(48 periods) and the next beside it."""
 
 
 def station_gap(scenario: Scenario) -> float:
@@ -44,13 +53,14 @@ def next_station(route: Route) -> np.ndarray | None:
 
 
 def who_waits(
-    routes: dict[int, Route], positions: np.ndarray, ids: list[int], gap: float, approach: float
+    routes: dict[int, Route], positions: np.ndarray, ids: list[int], gap: float, approach: float, spacing: float
 ) -> dict[int, list[int]]:
     """For each robot (index into ``ids``) that waits, the indices of the robots it waits for (see the module):
-    ``approach`` is how far a robot goes in a plan period."""
+    ``approach`` is how far a robot goes in a plan period, ``spacing`` the step of the test whether it stands on a
+    teammate's way (:func:`model.controllers.anicov.terrain_relief.in_the_way`)."""
     stations = {index: next_station(routes[agent]) for index, agent in enumerate(ids)}
     ahead = {index: place for index, place in stations.items() if place is not None}
-    distance = {index: float(np.hypot(*(place - positions[index]))) for index, place in ahead.items()}
+    left = {index: routes[ids[index]].stops[0].at - routes[ids[index]].progress for index in ahead}
     waits: dict[int, list[int]] = {}
     for index, place in ahead.items():
         first = [
@@ -59,7 +69,8 @@ def who_waits(
             if other != index
             and float(np.hypot(*(there - place))) < gap
             and float(np.hypot(*(there - positions[index]))) < gap + approach
-            and (distance[other], ids[other]) < (distance[index], ids[index])
+            and (left[other], ids[other]) < (left[index], ids[index])
+            and not in_the_way(routes[ids[other]], positions[index], gap, spacing)
         ]
         if first:
             waits[index] = first
@@ -67,11 +78,12 @@ def who_waits(
 
 
 def wait_carrot(
-    route: Route, position: np.ndarray, blockers: list[np.ndarray], gap: float, face_radius: float, spacing: float
+    route: Route, position: np.ndarray, blockers: list[np.ndarray], gap: float, face_radius: float, step: float
 ) -> np.ndarray:
     """The carrot of a robot at ``position`` that waits for the stations ``blockers`` (see the module): a point
-    ``face_radius`` / 2 toward its station (the law stands and faces it), or the point of its route behind it
-    (every ``spacing`` back from its progress) nearest it that is ``gap`` from every blocker."""
+    ``face_radius`` / 2 toward its station (the law stands and faces it) where it is ``gap`` from every blocker; else
+    its route's point at most ``step`` behind where it stands on it, toward the nearest point behind that is ``gap``
+    from every blocker (searched back from its progress every ``step``), or where it stands if there is none."""
     blocked = np.asarray(blockers, dtype=np.float64).reshape(-1, 2)
 
     def clear(point: np.ndarray) -> bool:
@@ -80,10 +92,9 @@ def wait_carrot(
     if not clear(position):
         at = route.progress
         while at > 0.0:
-            at = max(0.0, at - spacing)
-            back = route.point_at(at)
-            if clear(back):
-                return back
+            at = max(0.0, at - step)
+            if clear(route.point_at(at)):
+                return route.point_at(max(at, _standing_at(route, position, at, step) - step))
     station = next_station(route)
     toward = (station - position) if station is not None else np.zeros(2)
     length = float(np.hypot(*toward))
@@ -91,3 +102,12 @@ def wait_carrot(
         bearing = route.stops[0].bearings[0] if route.stops and route.stops[0].bearings else 0.0
         toward, length = np.array([math.cos(bearing), math.sin(bearing)]), 1.0
     return np.asarray(position, dtype=np.float64) + 0.5 * face_radius * toward / length
+
+
+def _standing_at(route: Route, position: np.ndarray, back: float, step: float) -> float:
+    """The arc length between ``back`` and the route's progress (every ``step`` / 4) nearest ``position``: where a
+    robot backing off along the route stands on it (the last such on a tie: the one it has come least far from)."""
+    count = max(1, math.ceil((route.progress - back) / (0.25 * step)))
+    arcs = np.linspace(back, route.progress, count + 1)
+    gaps = [float(np.hypot(*(route.point_at(float(arc)) - position))) for arc in arcs]
+    return float(arcs[len(gaps) - 1 - int(np.argmin(gaps[::-1]))])
