@@ -55,7 +55,8 @@ def test_a_tie_goes_to_the_lower_id_and_stations_far_apart_keep_everyone_going()
     apart = {0: route_to([6.5, 7.0], [6.5, 8.5]), 1: route_to([6.5, 10.5], [6.5, 8.5 + gap + 0.01])}
     assert who_waits(apart, np.array([[6.5, 7.0], [6.5, 10.5]]), [0, 1], gap, APPROACH, SPACING) == {}
     no_stop = {0: route_to([6.5, 7.0], [6.5, 8.5]), 1: Route.of(np.array([[6.5, 8.6]]), cleanup=True)}
-    assert who_waits(no_stop, np.array([[6.5, 7.0], [6.5, 8.6]]), [0, 1], gap, APPROACH, SPACING) == {}  # idle: make_way's
+    idle = np.array([[6.5, 7.0], [6.5, 8.6]])  # robot 1 stands with nothing to do: make_way's, not this rule's
+    assert who_waits(no_stop, idle, [0, 1], gap, APPROACH, SPACING) == {}
 
 
 def test_the_way_left_ranks_them_and_a_robot_on_the_other_s_way_does_not_wait_there():
