@@ -89,10 +89,11 @@ def test_the_anicov_controller_over_zenoh_equals_the_engine_with_the_same_messag
 
 def test_anicov_among_walls_with_bodies_over_zenoh_equals_the_engine_byte_for_byte(tmp_path):
     """Issue 36: anicov on a map with robot bodies and the safety filter (two rooms joined by a door, N = 4):
-    the coordinator's patches, detours, reliefs and cleanups are the engine's, carrot for carrot."""
+    the coordinator's patches, detours, reliefs, cleanups and turns at stations are the engine's, carrot for carrot
+    (seed 1: a robot waits its turn at a station in 10 of the run's 306 plans, measured in process at c7b31b6)."""
     config = write_scenario(
         tmp_path / "s.toml", domain=[24.0, 16.0], cell=1.0, range=5.0, robot_radius=0.4, occlusion=True,
-        agents=4, seed=2, controller="anicov",
+        agents=4, seed=1, controller="anicov",
         obstacles=[[[12.0, 0.0], [13.0, 0.0], [13.0, 6.0], [12.0, 6.0]],
                    [[12.0, 10.0], [13.0, 10.0], [13.0, 16.0], [12.0, 16.0]]],
     )  # fmt: skip
