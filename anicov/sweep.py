@@ -233,16 +233,28 @@ def run_sweep(
 
 def _check_same_base(sweep: Sweep, out_dir: Path) -> None:
     """OUT/sweep.json holds the base scenario (the fixed keys included) whose runs the table holds: a row
-    is reused only for the same base, so a sweep resumed with other fixed keys is refused, not mixed."""
+    is reused only for the same base, so a sweep resumed with other fixed keys is refused, not mixed. A map file
+    is held by its path from OUT (:func:`_portable`), so a study resumes from any checkout that keeps both."""
     import json
 
     record = out_dir / "sweep.json"
-    base = sweep.base.to_dict()
+    base = _portable(json.loads(json.dumps(sweep.base.to_dict())), out_dir)
     if record.exists():
-        if json.loads(record.read_text(encoding="utf-8")).get("base") != json.loads(json.dumps(base)):
+        if _portable(json.loads(record.read_text(encoding="utf-8")).get("base", {}), out_dir) != base:
             raise ScenarioError(f"{out_dir}: holds runs of another base scenario or fixed keys; give another --out")
         return
     record.write_text(json.dumps({"base": base}, indent=1) + "\n", encoding="utf-8")
+
+
+def _portable(base: dict[str, Any], out_dir: Path) -> dict[str, Any]:
+    """``base`` with its map file's path relative to ``out_dir`` (an absolute one, as sweep.json held it before
+    2026-12-07, is made relative too: the same file from the same checkout compares equal)."""
+    if not base.get("map"):
+        return base
+    where = Path(base["map"])
+    if not where.is_absolute():
+        return base
+    return {**base, "map": os.path.relpath(where.resolve(), out_dir.resolve())}
 
 
 def _results(

@@ -217,3 +217,32 @@ def test_a_sweep_with_physics_carries_the_contacts_and_the_truth_and_a_kinematic
     assert rows["kinematic"]["physical_contacts"] == rows["kinematic"]["true_coverage"] == ""
     kinematic = load_sweep(write_sweep(tmp_path, text=SMALL))
     assert "true_coverage" not in kinematic.columns  # its tables, and resumed ones, keep their columns
+
+
+def test_a_study_on_a_map_resumes_from_another_checkout_its_map_held_by_its_path_from_the_table(tmp_path):
+    """sweep.json held the map's absolute path, so a study's tables (docs/physics/study/) resumed only from a checkout
+    at the same place. It holds the path from OUT now; a record in the old form still resumes from its own checkout."""
+    import json
+    import shutil
+
+    first = tmp_path / "first"
+    (first / "maps").mkdir(parents=True)
+    for name in ("field.yaml", "field.pgm"):
+        shutil.copy(ROOT / "scenarios" / "maps" / name, first / "maps" / name)
+    (first / "scenario.toml").write_text('map = "maps/field.yaml"\nrange = 8.0\nmax_time = 2.0\n')
+    (first / "sweep.toml").write_text('scenario = "scenario.toml"\nseeds = 1\n[grid]\nagents = [1, 2]\n')
+    assert run_sweep(load_sweep(first / "sweep.toml"), first / "out", workers=1, progress=False) == (0, 2)
+    record = json.loads((first / "out" / "sweep.json").read_text())
+    assert record["base"]["map"] == os.path.join("..", "maps", "field.yaml")
+
+    moved = tmp_path / "elsewhere" / "checkout"
+    shutil.copytree(first, moved)
+    assert run_sweep(load_sweep(moved / "sweep.toml"), moved / "out", workers=1, progress=False) == (2, 0)
+
+    record["base"]["map"] = str((moved / "maps" / "field.yaml").resolve())  # as sweep.json held it before
+    (moved / "out" / "sweep.json").write_text(json.dumps(record))
+    assert run_sweep(load_sweep(moved / "sweep.toml"), moved / "out", workers=1, progress=False) == (2, 0)
+    record["base"]["map"] = str((first / "maps" / "field.yaml").resolve())  # another checkout's file: refused
+    (moved / "out" / "sweep.json").write_text(json.dumps(record))
+    with pytest.raises(ScenarioError, match="another base scenario"):
+        run_sweep(load_sweep(moved / "sweep.toml"), moved / "out", workers=1, progress=False)
