@@ -77,6 +77,13 @@ SEERS_TRIED = 5
 """A short cell that no candidate's sure stare reaches tries this many of its nearest seers."""
 SHIFT_SPREADS = 3.0
 """How far from a seer's centre, in face radii, a station that surely sees past a wall's corner is tried."""
+FINE_SHIFTS = (1.0, 2.0)
+"""With a localiser's noise, the rings (face radii from a seer's centre) tried after :data:`SHIFT_SPREADS`'s: its
+face radius is a quarter of a cell on the MRPT lab (σ 0.05 m, cells of 0.2 m), and a ring 0.15 m off jumps over
+the sliver from which a cell seen through a gap in the SLAM map's islands is seen. The cell (57, 42) had a seer
+sure over no spread but 0, so a robot arriving 1 σ off never saw it, and the run ended with the cell given up;
+a point 1.8 face radii off that seer's centre sees it surely over 1.5. Without noise the face radius is half a
+step, and the runs stay as they were (the rings are not tried)."""
 CANDIDATE_STRIDE = 3
 """Candidate stations lie on every this-many-th row and column of reachable cells (at 36 µs a stare and 24
 bearings, a few hundred candidates cost a few tenths of a second)."""
@@ -279,23 +286,27 @@ def _sure_seer(
     """(station, its sure stares) that reach the cell ``flat``: among the :data:`SEERS_TRIED` nearest seers not
     banned (:meth:`World.seers_of`, the cells whose centres see it), the first whose centre, or a point
     :data:`SHIFT_SPREADS` face radii from it toward one of 8 ways, sees it from everywhere a robot standing there
-    may be (a cell seen past a wall's corner is seen from one side of a line through the seer, not the other);
-    where none does, the same over each narrower spread of :data:`SEER_SPREADS`."""
+    may be (a cell seen past a wall's corner is seen from one side of a line through the seer, not the other),
+    then, with a localiser's noise, the points on the rings of :data:`FINE_SHIFTS`; where none does, the same
+    over each narrower spread of :data:`SEER_SPREADS`."""
     scenario = world.scenario
     cell, face = scenario.cell, face_radius_of(scenario)
     row, col = divmod(flat, scenario.grid_shape[1])
     seers = [s for s in world.seers_of((col + 0.5) * cell, (row + 0.5) * cell)[:, 1:] if cell_of(s, cell) not in banned]
-    ways = np.array([(0.0, 0.0), *((np.cos(a), np.sin(a)) for a in np.arange(8) * np.pi / 4)])
+    ways = np.array([(np.cos(a), np.sin(a)) for a in np.arange(8) * np.pi / 4])
+    groups = [np.vstack([np.zeros((1, 2)), SHIFT_SPREADS * face * ways])]
+    if dict(scenario.noise).get("localiser_sigma", 0.0) > 0.0:  # after the others: what they find is kept
+        groups.append(np.vstack([np.zeros((0, 2)), *(ring * face * ways for ring in FINE_SHIFTS)]))
     ground = world.ground
     stations = []
-    for seer in seers[:SEERS_TRIED]:
-        for way in ways:
-            station = seer + SHIFT_SPREADS * face * way
-            if not in_reachable_cell(world.reachable, *station, scenario.cell):
-                continue  # a wide face radius (a noisy localiser's) shifts it off the team's space: no path goes there
-            if not in_sight(ground.wall_grid, *seer, *station, ground.grain, ground.plan_radius, ground.bounded):
-                continue  # the disk with its clearance does not fit there: the filter would hold it short
-            stations.append(station)
+    for offsets in groups:
+        for seer in seers[:SEERS_TRIED]:
+            for station in seer + offsets:
+                if not in_reachable_cell(world.reachable, *station, scenario.cell):
+                    continue  # a wide face radius (a noisy localiser's) shifts it off the team's space
+                if not in_sight(ground.wall_grid, *seer, *station, ground.grain, ground.plan_radius, ground.bounded):
+                    continue  # the disk with its clearance does not fit there: the filter would hold it short
+                stations.append(station)
     for spread in SEER_SPREADS:  # the places tried once, over each spread in turn
         for station in stations:
             stares = deposit.sure_stares(station[None, :], ANGLES, spread * face)
