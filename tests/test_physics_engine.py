@@ -101,9 +101,11 @@ def test_the_shipped_two_rooms_are_the_ones_measured_here():
 def test_the_clearance_reserve_keeps_two_robots_apart_with_a_poor_localiser_and_late_commands():
     """Issue 37, item 5: two robots start facing each other in a corridor, their localiser off by σ = 0.1, their
     odometry drifting 1 % (with exact odometry the fused belief would take nothing from the fixes and be the
-    truth) and their commands a whole second late (10 periods). The reserve (3 σ + k_v × 1.0 + k_v² / 2a = 1.345
-    each, beyond s) keeps their true bodies apart; with ``clearance_reserve = 0`` the same run has a robot
-    contact (2, completing in 278.0; with the reserve 245.0)."""
+    truth) and their commands a whole second late (10 periods). The reserve (3 σ of the fused belief + k_v × 1.0
+    + k_v² / 2a = 1.102 each, beyond s) keeps their true bodies apart (the least gap of their true centres 1.958,
+    complete at 309.0); with ``clearance_reserve = 0`` the same run has robot contacts (3, complete at 262.4).
+    Before the filter asked a robot inside a teammate's margin only not to come nearer when nothing else was
+    safe, both stood for good from t = 210 here."""
     scenario = validate({
         "domain": [20.0, 8.0], "cell": 1.0, "range": 5.0, "robot_radius": 0.4, "agents": 2, "seed": 0,
         "safety_range": 6.0, "physics": "mujoco", "max_time": 600.0, "initial_poses": [[1.5, 4.0, 0.0], [18.5, 4.0, 180.0]],

@@ -2,11 +2,19 @@
 
 import math
 
+import numpy as np
 import pytest
 
 from model.parameters import safety_parameters
+from model.physics.noise import fix_gains, noise_of, predicted_variance
 from model.scenario import ScenarioError, validate
-from model.scenario.physics_keys import clearance_reserve_of, cover_margin_of, safety_margin_of, sure_doubt_of
+from model.scenario.physics_keys import (
+    belief_sigma_of,
+    clearance_reserve_of,
+    cover_margin_of,
+    safety_margin_of,
+    sure_doubt_of,
+)
 from model.world.world import wall_clearance_of
 
 BODY = {"robot_radius": 0.3}
@@ -57,18 +65,44 @@ def test_the_sure_rule_doubts_the_pose_by_sure_sigmas_times_the_localiser_sigma(
 
 
 def test_the_clearance_reserve_takes_the_pose_error_the_late_command_and_the_braking():
-    """Issue 37, item 5: 3 σ + k_v × command_latency + k_v² / 2a beyond safety_margin, for the filter, the
+    """Issue 37, item 5: 3 σ of the belief + k_v × command_latency + k_v² / 2a beyond safety_margin, for the filter, the
     ground and the planner alike; 0 for kinematic robots; the [noise] table's clearance_reserve if given."""
     assert clearance_reserve_of(validate(BODY)) == 0.0 and safety_margin_of(validate(BODY)) == 0.2
     still = validate({**BODY, "k_v": 2.0, "physics": "mujoco", "robot": {"acceleration": 8.0}})
     assert clearance_reserve_of(still) == pytest.approx(2.0**2 / (2.0 * 8.0))
+    fixes = {"localiser_sigma": 0.05, "localiser_rate": 10.0, "odometry_per_metre": 0.01}
     noisy = validate({
-        **BODY, "physics": "mujoco", "noise": {"localiser_sigma": 0.05, "command_latency": 0.1, "cover_margin": 0.3},
+        **BODY, "physics": "mujoco", "noise": {**fixes, "command_latency": 0.1, "cover_margin": 0.3},
     })  # fmt: skip
-    reserve = 3 * 0.05 + 1.0 * 0.1 + 1.0 / (2.0 * 11.0)  # k_v 1, the Burger's acceleration 11 k_v
+    assert 0.0 < belief_sigma_of(noisy) < 0.05  # the fused belief is surer than one fix
+    reserve = 3 * belief_sigma_of(noisy) + 1.0 * 0.1 + 1.0 / (2.0 * 11.0)  # k_v 1, the Burger's acceleration 11 k_v
     assert clearance_reserve_of(noisy) == pytest.approx(reserve)
     assert safety_parameters(noisy).margin == pytest.approx(0.2 + reserve)
     assert safety_parameters(noisy).pair_margin == pytest.approx(0.2 + 2.0 * reserve)  # each robot brings its own
     assert wall_clearance_of(noisy) == pytest.approx(0.3 + 0.2 + reserve)
     given = validate({**BODY, "physics": "mujoco", "noise": {"localiser_sigma": 0.05, "clearance_reserve": 0}})
     assert safety_margin_of(given) == 0.2 and cover_margin_of(given) > 0.0  # a rule, the noise still noise
+
+
+@pytest.mark.parametrize("rate, latency", [(10.0, 0.0), (10.0, 0.1), (2.5, 0.3)])
+def test_the_beliefs_sigma_is_the_steady_state_of_the_beliefs_own_variance(rate, latency):
+    """belief_sigma_of, in closed form, against model.physics.noise's recursion run to its steady state: a robot
+    that drives at k_v and turns at π k_ω every step, a fix every 1 / rate (its variance fused by the Kalman
+    gain), the variance taken just before a fix; with a latency, the odometry of that many more steps on it."""
+    noise_table = {
+        "odometry_per_metre": 0.01, "odometry_per_radian": 0.01, "localiser_sigma": 0.05,
+        "localiser_heading_deg": 2.0, "localiser_rate": rate, "localiser_latency": latency,
+    }  # fmt: skip
+    scenario = validate({**BODY, "k_omega": 0.9, "physics": "mujoco", "noise": noise_table})
+    noise = noise_of(scenario)
+    motion = np.array([[scenario.k_v * scenario.dt, 0.0, math.pi * scenario.k_omega * scenario.dt]])
+    variance, before_fix = np.zeros((1, 2)), 0.0
+    for step in range(1, 4001):
+        variance = predicted_variance(variance, motion, noise)
+        if step % noise.localiser_period == 0:
+            before_fix = float(variance[0, 0])
+            variance = (1.0 - fix_gains(variance, noise)) * variance
+    gathered = before_fix - float(variance[0, 0])  # what a period of odometry adds
+    worst = before_fix + noise.localiser_delay * gathered / noise.localiser_period
+    assert belief_sigma_of(scenario) == pytest.approx(math.sqrt(worst), rel=1e-6)
+    assert belief_sigma_of(validate({**BODY, "physics": "mujoco", "noise": {"localiser_sigma": 0.05}})) == 0.0

@@ -184,6 +184,14 @@ def safe_velocities(
         for k in range(first_wall, count):
             c[k] = min(c[k], 0.0)
         feasible, v, lw = project_onto_polygon(gx, gy, c, count, target_v, target_l)
+    if not feasible:
+        # The same inside a teammate's margin: a point that must leave sideways at γ·|h| per step cannot (a
+        # unicycle's point moves sideways at most l·ω_max), and two robots stood for good, v = ω = 0 (a corridor,
+        # commands 1.0 late, the teammate ahead and a wall's margin behind). Asked only not to come nearer, the
+        # one may back off and the other turn.
+        for k in range(first_teammate, first_wall):
+            c[k] = min(c[k], 0.0)
+        feasible, v, lw = project_onto_polygon(gx, gy, c, count, target_v, target_l)
     worst, wall_x, wall_y = 0.0, 0.0, 0.0  # the wall the law's command presses on most
     for k in range(first_wall, count):
         shortfall = c[k] - (gx[k] * target_v + gy[k] * target_l)
