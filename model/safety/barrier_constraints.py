@@ -181,16 +181,15 @@ def safe_velocities(
         # get out at γ·|h| per step. Nearly along the wall (|n·e| < κ) no v does that, and the robot stood
         # for good, v = ω = 0 (two rooms, the issue's noise: 1.05 from its station at a wall's end, for the
         # rest of the run). Asked only not to go deeper, it may stand and turn; its next step can then leave.
-        for k in range(first_wall, count):
-            c[k] = min(c[k], 0.0)
+        _only_not_deeper(c, first_wall, count, 0.0)
         feasible, v, lw = project_onto_polygon(gx, gy, c, count, target_v, target_l)
     if not feasible:
-        # The same inside a teammate's margin: a point that must leave sideways at γ·|h| per step cannot (a
-        # unicycle's point moves sideways at most l·ω_max), and two robots stood for good, v = ω = 0 (a corridor,
-        # commands 1.0 late, the teammate ahead and a wall's margin behind). Asked only not to come nearer, the
-        # one may back off and the other turn.
-        for k in range(first_teammate, first_wall):
-            c[k] = min(c[k], 0.0)
+        # The same inside a teammate's margin (h < 0: its bound is above the slack's ε/dt): a point that must leave
+        # sideways at γ·|h| per step cannot (a unicycle's point moves sideways at most l·ω_max), and two robots
+        # stood for good, v = ω = 0 (a corridor, commands 1.0 late, the teammate ahead and a wall's margin
+        # behind). Asked only not to come nearer, the one may back off and the other turn. A barrier that still
+        # holds (h ≥ 0) keeps its bound, slack and all; if the QP is still empty the robot stops.
+        _only_not_deeper(c, first_teammate, first_wall, safety.slack / safety.dt)
         feasible, v, lw = project_onto_polygon(gx, gy, c, count, target_v, target_l)
     worst, wall_x, wall_y = 0.0, 0.0, 0.0  # the wall the law's command presses on most
     for k in range(first_wall, count):
@@ -198,3 +197,12 @@ def safe_velocities(
         if shortfall > worst:
             worst, wall_x, wall_y = shortfall, normals[k, 0], normals[k, 1]
     return v, lw / ahead, feasible, binding, stale, wall_x, wall_y
+
+
+@njit(cache=True)
+def _only_not_deeper(c: np.ndarray, first: int, last: int, inside: float) -> None:
+    """Barriers ``first`` to ``last`` whose bound is above ``inside`` (the robot is inside their margin: h < 0)
+    ask only that it go no deeper: bound 0."""
+    for k in range(first, last):
+        if c[k] > inside:
+            c[k] = 0.0

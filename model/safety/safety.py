@@ -19,8 +19,10 @@ Agrawal & Sreenath (RSS 2017), with each robot taking half of each pair's constr
   A wall does not move, so the centre itself carries this barrier, with the whole of γ:
   v·dt·(n·e) − |v|·dt·κ ≥ −γ·h, κ = ω_max·dt/2 (the arc's turn off its chord), two half-planes in v.
 * Velocity bounds of the paper: |v| ≤ k_v, |ω| ≤ π·k_ω (eq. 15–16), as four more half-planes.
-* The QP min |z − ẑ|² over them is solved exactly (:mod:`model.safety.barrier_qp`); if it is empty the robot
-  stops (v = ω = 0: Δ = 0 keeps its half of every constraint), as the Robotarium's does.
+* The QP min |z − ẑ|² over them is solved exactly (:mod:`model.safety.barrier_qp`). If it is empty, the
+  barriers already broken (h < 0: a belief off the truth, a late command), walls first and then teammates, ask
+  only not to go deeper; if it is empty still the robot stops (v = ω = 0: Δ = 0 keeps its half of every
+  constraint), as the Robotarium's does. Where every barrier holds, nothing is relaxed.
 
 Deadlock (a robot held still by a teammate for ``STUCK_STEPS`` steps): the standard remedy of a
 rotation bias (the "keep right" rule, Wang et al. 2017, Sec. VI; Grover et al. 2016): the nominal

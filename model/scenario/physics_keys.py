@@ -97,17 +97,21 @@ error (:func:`clearance_reserve_of`). The MRPT lab with the issue's noise (σ 0.
 def belief_sigma_of(scenario: Any) -> float:
     """σ in position (each axis) of a robot's belief at its worst, the fixes fused by the Kalman gain of
     :mod:`model.physics.noise` (``predicted_variance``, ``fix_gains``): its steady variance after a fix, for a
-    robot that drives at k_v and turns at its most, π k_ω (eq. 16), between every two fixes, plus what the
-    odometry adds before the next fix arrives (the fixes' period and their latency). The heading's doubt
-    carries into position as d² P_θ per step of way d, as the belief counts it. 0 without a localiser (``localiser_rate``
-    0: the odometry's drift then grows without bound, and the reserve does not take it)."""
+    robot that drives at k_v and turns at its most, π k_ω (eq. 16), every step between two fixes, plus what the
+    odometry adds over a period before the next fix, and over the fixes' latency besides (a fix of the pose
+    that long ago, replayed to now: an estimate that errs high). The heading's doubt carries into position as
+    d² P_θ per step of way d, as the belief counts it. 0 without a localiser (``localiser_rate`` 0: the
+    odometry's drift then grows without bound, and the reserve does not take it)."""
     given = dict(scenario.noise)
     rate = given.get("localiser_rate", 0.0)
     if rate <= 0.0:
         return 0.0
     period = max(1, round(1.0 / (rate * scenario.dt)))  # in steps, as model.physics.noise counts them
     delay = round(given.get("localiser_latency", 0.0) / scenario.dt)
-    step_way, step_turn = scenario.k_v * scenario.dt, math.pi * scenario.k_omega * scenario.dt
+    step_turn = math.pi * scenario.k_omega * scenario.dt
+    half = 0.5 * step_turn  # eq. 1's step: a chord k_v dt sinc(half) along the mean heading, half a turn round
+    chord = scenario.k_v * scenario.dt * (math.sin(half) / half if half > 1e-9 else 1.0)
+    step_way = chord * (math.cos(half) + abs(math.sin(half)))  # forward and sideways, as the odometry counts it
     turn_q = given.get("odometry_per_radian", 0.0) ** 2 * step_turn
     heading = _steady_after_fix(period * turn_q, math.radians(given.get("localiser_heading_deg", 0.0)) ** 2)
     position_q = period * (given.get("odometry_per_metre", 0.0) ** 2 * step_way + step_way**2 * heading)

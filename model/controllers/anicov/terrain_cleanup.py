@@ -290,8 +290,8 @@ def _sure_seer(
     :data:`SHIFT_SPREADS` face radii from it toward one of 8 ways, sees it from everywhere a robot standing there
     may be (a cell seen past a wall's corner is seen from one side of a line through the seer, not the other),
     then, with a localiser's noise, the points of :func:`fine_rings`; where none does, the same over each
-    narrower spread of :data:`SEER_SPREADS`. Only the places whose stare reaches the cell at all are tried
-    over the spreads."""
+    narrower spread of :data:`SEER_SPREADS`. A place whose own stare does not reach the cell is not tried
+    over any spread (a sure stare is the least of its own and its neighbours')."""
     scenario = world.scenario
     cell, face = scenario.cell, face_radius_of(scenario)
     row, col = divmod(flat, scenario.grid_shape[1])
@@ -310,9 +310,13 @@ def _sure_seer(
                 if not in_sight(ground.wall_grid, *seer, *station, ground.grain, ground.plan_radius, ground.bounded):
                     continue  # the disk with its clearance does not fit there: the filter would hold it short
                 stations.append(station)
-    stations = [station for station in stations if deposit.sure_stares(station[None, :], ANGLES, 0.0)[flat].sum()]
+    reaches: dict[int, bool] = {}  # whether a place's own stare reaches the cell: else no spread's can
     for spread in SEER_SPREADS:  # the places tried once, over each spread in turn
-        for station in stations:
+        for index, station in enumerate(stations):
+            if index not in reaches:
+                reaches[index] = bool(deposit.stares(station[None, :], ANGLES)[flat].sum() > 0.0)
+            if not reaches[index]:
+                continue
             stares = deposit.sure_stares(station[None, :], ANGLES, spread * face)
             if stares[flat].sum() > 0.0:
                 return station, stares
