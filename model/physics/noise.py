@@ -32,7 +32,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from model.scenario import Scenario
-from model.scenario.physics_keys import cover_margin_of
+from model.scenario.physics_keys import cover_margin_of, localiser_steps_of
 
 NOISE_SEED_SALT = 37
 """Mixed into the scenario's seed, so that the noise does not repeat the start poses' draw."""
@@ -58,14 +58,14 @@ class Noise:
 def noise_of(scenario: Scenario) -> Noise:
     """The scenario's ``[noise]`` table, its times in whole control periods."""
     given = dict(scenario.noise)
-    rate = given.get("localiser_rate", 0.0)
+    period, delay = localiser_steps_of(scenario)
     return Noise(
         odometry_per_metre=given.get("odometry_per_metre", 0.0),
         odometry_per_radian=given.get("odometry_per_radian", 0.0),
         localiser_sigma=given.get("localiser_sigma", 0.0),
         localiser_heading=math.radians(given.get("localiser_heading_deg", 0.0)),
-        localiser_period=max(1, round(1.0 / (rate * scenario.dt))) if rate > 0.0 else 0,
-        localiser_delay=round(given.get("localiser_latency", 0.0) / scenario.dt),
+        localiser_period=period,
+        localiser_delay=delay,
         command_delay=round(given.get("command_latency", 0.0) / scenario.dt),
         cover_margin=cover_margin_of(scenario),
     )

@@ -103,11 +103,9 @@ def belief_sigma_of(scenario: Any) -> float:
     d² P_θ per step of way d, as the belief counts it. 0 without a localiser (``localiser_rate`` 0: the
     odometry's drift then grows without bound, and the reserve does not take it)."""
     given = dict(scenario.noise)
-    rate = given.get("localiser_rate", 0.0)
-    if rate <= 0.0:
+    period, delay = localiser_steps_of(scenario)
+    if not period:
         return 0.0
-    period = max(1, round(1.0 / (rate * scenario.dt)))  # in steps, as model.physics.noise counts them
-    delay = round(given.get("localiser_latency", 0.0) / scenario.dt)
     step_turn = math.pi * scenario.k_omega * scenario.dt
     half = 0.5 * step_turn  # eq. 1's step: a chord k_v dt sinc(half) along the mean heading, half a turn round
     chord = scenario.k_v * scenario.dt * (math.sin(half) / half if half > 1e-9 else 1.0)
@@ -118,6 +116,16 @@ def belief_sigma_of(scenario: Any) -> float:
     position_q += step_way**2 * turn_q * period * (period - 1) / 2  # the heading's doubt grows between fixes
     position = _steady_after_fix(position_q, given.get("localiser_sigma", 0.0) ** 2)
     return math.sqrt(position + (period + delay) / period * position_q)
+
+
+def localiser_steps_of(scenario: Any) -> tuple[int, int]:
+    """(control periods between two fixes, 0 without a localiser; periods from the pose a fix measures to its
+    arrival): ``localiser_rate`` and ``localiser_latency`` in whole periods, as the belief
+    (:func:`model.physics.noise.noise_of`) and the reserve (:func:`belief_sigma_of`) both count them."""
+    given = dict(scenario.noise)
+    rate = given.get("localiser_rate", 0.0)
+    period = max(1, round(1.0 / (rate * scenario.dt))) if rate > 0.0 else 0
+    return period, round(given.get("localiser_latency", 0.0) / scenario.dt)
 
 
 def _steady_after_fix(gathered: float, measured: float) -> float:

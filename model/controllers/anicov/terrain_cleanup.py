@@ -324,10 +324,14 @@ def _sure_seer(
 
 
 def fine_rings(face: float) -> np.ndarray:
-    """(M, 2) the offsets of :data:`FINE_RINGS`' points from a seer's centre, ring by ring."""
+    """(M, 2) the offsets of :data:`FINE_RINGS`' points from a seer's centre, ring by ring, less the 8 of the ring
+    :data:`SHIFT_SPREADS` off (tried before them: tried again, they would find nothing new)."""
     rings = [np.zeros((0, 2))]
     for ring in range(1, FINE_RINGS + 1):
-        angles = np.arange(8 * ring) * 2.0 * np.pi / (8 * ring)
+        steps = np.arange(8 * ring)
+        if ring == SHIFT_SPREADS:
+            steps = steps[steps % ring != 0]  # the 8 ways every 45°
+        angles = steps * 2.0 * np.pi / (8 * ring)
         rings.append(ring * face * np.stack([np.cos(angles), np.sin(angles)], axis=1))
     return np.vstack(rings)
 
