@@ -9,9 +9,11 @@ import pytest
 
 from anicov.engine import run_scenario
 from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop, face_radius_of
-from model.controllers.anicov.terrain_turns import station_gap, wait_carrot, who_waits
+from model.controllers.anicov.terrain_relief import aside
+from model.controllers.anicov.terrain_turns import aside_carrot, station_gap, wait_carrot, who_waits
 from model.scenario import load_scenario
 from model.scenario.physics_keys import pair_margin_of
+from model.world.world import world_of
 from tests.test_real_maps import REAL, map_of
 from tests.test_terrain_stations import ROOMS
 
@@ -108,3 +110,20 @@ def test_the_lab_run_two_pairs_of_neighbouring_stations_held_now_completes():
     scenario = load_scenario(scenario_path).with_overrides(agents=10, seed=4, controller="anicov", max_time=1500.0)
     result = run_scenario(scenario, record_trace=False)
     assert result.completed and not result.given_up.any()
+
+
+def test_two_robots_each_on_the_other_s_way_take_turns_and_the_second_steps_aside():
+    """Two robots 0.11 and 0.14 off their stations 0.3 apart (the MRPT lab, N = 10, seed 7, with noise): each stands
+    on the other's way, so going held both for good. Now the lower id goes and the other waits out of both ways."""
+    gap = station_gap(ROOMS)
+    routes = {0: route_to([6.0, 8.4], [6.3, 8.5]), 7: route_to([6.7, 8.2], [6.6, 8.5])}
+    positions = np.array([[6.19, 8.46], [6.63, 8.36]])
+    for route in routes.values():
+        route.progress = route.length  # held off its station, at the end of its route
+    assert who_waits(routes, positions, [0, 7], gap, APPROACH, SPACING) == {1: [0]}
+    world = world_of(ROOMS)
+    carrot = aside_carrot(world, positions[1], [routes[0]], gap, APPROACH)
+    assert carrot is not None and np.hypot(*(carrot - positions[1])) == pytest.approx(APPROACH, abs=1e-6)
+    place = aside(world, positions[1], [routes[0]], gap)
+    assert np.hypot(*(place - np.array([6.3, 8.5]))) >= 1.5 * gap  # out of robot 0's way to its station
+    assert aside_carrot(world, np.array([6.5, 3.0]), [routes[0]], gap, APPROACH) is None  # not on its way: no step

@@ -33,11 +33,10 @@ from model.controllers.anicov.route import CARROT_PERIOD, Route, face_radius_of
 from model.controllers.anicov.routes import bottleneck_assignment
 from model.controllers.anicov.stations import bearing_sequence, whole_periods
 from model.controllers.anicov.terrain_routes import station_tour, travel_lengths
+from model.controllers.anicov.terrain_seers import SURE_SPREADS, with_seers
 from model.controllers.anicov.terrain_stations import ANGLES
 from model.planning import path_lengths
 from model.scenario import Scenario
-from model.world.geodesic import in_sight
-from model.world.reachability import in_reachable_cell
 from model.world.world import World
 
 CLEANUP_DEMAND = 1.1
@@ -63,29 +62,6 @@ LARGE_NODE_LIMIT = 20
 PATCH_REACH = 0.25
 """A station patches a short cell only where one period of its stare brings at least this share of what the
 cell lacks."""
-SURE_SPREADS = 1.5
-"""A stare is sure when it reaches a cell from every point this many face radii from its station. A robot may
-stand up to its arrival radius off (route.arrive_radius_of, at most a step); sure over 1.5 arrival radii, the
-lab's cleanups asked for stares too few cells pass and its runs stalled (four of four trials), so the spread
-stays the face radius's, which held in every run of the study."""
-SEER_SPREADS = (SURE_SPREADS, 0.5, 0.0)
-"""The spreads, in face radii, a short cell's own seer is sure over (:func:`_sure_seer`), widest first: a cell seen
-only through a gap, from one cell's centre, is seen from no point a noisy localiser's face radius round it
-(the MRPT lab, σ 0.05 m on cells of 0.2 m: 7 - 16 cells stood short for ever with no station, the run never done).
-A narrower seer may be flown in vain; its cleanup is then judged and banned (:mod:`terrain_flight`)."""
-SEERS_TRIED = 5
-"""A short cell that no candidate's sure stare reaches tries this many of its nearest seers."""
-SHIFT_SPREADS = 3.0
-"""How far from a seer's centre, in face radii, a station that surely sees past a wall's corner is tried."""
-FINE_RINGS = 4
-"""With a localiser's noise, a seer is also tried on rings 1, 2, ... this many face radii from its centre, the
-k-th ring at 8 k points (about 0.8 face radii apart), after the centres and the ring of :data:`SHIFT_SPREADS`,
-whose finds are kept. The face radius is then a quarter of a cell on the MRPT lab (σ 0.05 m, cells of 0.2 m), and
-8 points 0.15 m off jump over the sliver from which a cell seen through a gap in the SLAM map's islands is seen.
-Of the lab's 2,426 coverable cells, 11 had no station sure over 1.5 face radii, and 3 of them get one on these
-rings; a robot arriving 1 σ off a station sure over less may see nothing of its cell (N = 10, seed 1: the cell
-(41, 56) given up at t = 797 before the rings, complete with them). Without noise the face radius is half a
-step, and the runs stay as they were (the rings are not tried)."""
 CANDIDATE_STRIDE = 3
 """Candidate stations lie on every this-many-th row and column of reachable cells (at 36 µs a stare and 24
 bearings, a few hundred candidates cost a few tenths of a second)."""
@@ -189,15 +165,29 @@ def cleanup_stations(
     spread = SURE_SPREADS * face_radius_of(world.scenario)
     stations = _candidates(world, short, banned)
     stares = deposit.sure_stares(stations, ANGLES, spread)
-    stations, stares = _with_seers(world, deposit, short, (stations, stares), banned)
+    wanted_all = np.minimum(CLEANUP_DEMAND * need.ravel() + CLEANUP_MARGIN, 1.0)
+    least = _least_a_period(world.scenario, wanted_all)
+    stations, stares = with_seers(world, deposit, short, (stations, stares), banned, least)
     rows = np.flatnonzero(short.ravel() & (np.asarray(stares.sum(axis=1)).ravel() > 0.0))
     if not len(rows):
         return empty
     demand = stares.tocsr()[rows]
-    wanted = np.minimum(CLEANUP_DEMAND * need.ravel()[rows] + CLEANUP_MARGIN, 1.0)
+    wanted = wanted_all[rows]
     periods = _fewest_stations(demand.tocsc(), wanted, world.scenario).reshape(len(stations), len(ANGLES))
     used = periods.sum(axis=1) > 0
     return _merged(stations[used], periods[used])
+
+
+def _least_a_period(scenario: Scenario, wanted: np.ndarray) -> np.ndarray:
+    """What a short cell's stations must bring it in a period (Λ*, their best bearings summed) before it is left
+    without a seer of its own (:func:`terrain_seers.with_seers`): with a localiser's noise, ``wanted`` over
+    :data:`MOST_PERIODS` (the most the programme gives a station); else any stare at all (0). A cell that the
+    candidates reach only at a wedge's rim, through the spread of a sure stare, was otherwise stared at for the
+    relaxed programme's hundreds of periods (the MRPT lab, N = 10, seed 0: 710 periods at 0.0014 Λ*, 355 time
+    units of a 601.3 run, where its own seer's stares bring 0.071)."""
+    if dict(scenario.noise).get("localiser_sigma", 0.0) > 0.0:
+        return wanted / MOST_PERIODS
+    return np.zeros_like(wanted)
 
 
 def _merged(stations: np.ndarray, periods: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -255,90 +245,6 @@ def _candidates(world: World, short: np.ndarray, banned: frozenset[tuple[int, in
     near &= (rows % CANDIDATE_STRIDE == 0) & (cols % CANDIDATE_STRIDE == 0)
     kept = [(row, col) for row, col in np.argwhere(near) if (int(row), int(col)) not in banned]
     return (np.array(kept, dtype=np.float64).reshape(-1, 2)[:, ::-1] + 0.5) * cell
-
-
-def _with_seers(
-    world: World,
-    deposit: Deposit,
-    short: np.ndarray,
-    candidates: tuple[np.ndarray, csc_matrix],
-    banned: frozenset[tuple[int, int]],
-) -> tuple[np.ndarray, csc_matrix]:
-    """While a short cell lies outside every stare (``candidates``: stations and their sure stares), a station
-    that surely sees it joins them (:func:`_sure_seer`; a cell none sees is left: the engine's watchdog reports
-    what no robot can cover)."""
-    stations, stares = candidates
-    seen = np.asarray(stares.sum(axis=1)).ravel() > 0.0
-    waiting = np.flatnonzero(short.ravel() & ~seen)
-    added, blocks = [], [stares]
-    while len(waiting):
-        found = _sure_seer(world, deposit, int(waiting[0]), banned)
-        if found is not None:
-            added.append(found[0][None, :])
-            blocks.append(found[1])
-            seen |= np.asarray(found[1].sum(axis=1)).ravel() > 0.0
-        seen[waiting[0]] = True  # tried once
-        waiting = waiting[~seen[waiting]]
-    return np.vstack([stations.reshape(-1, 2), *added]), hstack(blocks).tocsc()
-
-
-def _sure_seer(
-    world: World, deposit: Deposit, flat: int, banned: frozenset[tuple[int, int]]
-) -> tuple[np.ndarray, csc_matrix] | None:
-    """(station, its sure stares) that reach the cell ``flat``: among the :data:`SEERS_TRIED` nearest seers not
-    banned (:meth:`World.seers_of`, the cells whose centres see it), the first whose centre, or a point
-    :data:`SHIFT_SPREADS` face radii from it toward one of 8 ways, sees it from everywhere a robot standing there
-    may be (a cell seen past a wall's corner is seen from one side of a line through the seer, not the other),
-    then, with a localiser's noise, the points of :func:`fine_rings`; where none does, the same over each
-    narrower spread of :data:`SEER_SPREADS`. A place whose own stare does not reach the cell is not tried
-    over any spread (a sure stare is the least of its own and its neighbours')."""
-    scenario = world.scenario
-    cell, face = scenario.cell, face_radius_of(scenario)
-    row, col = divmod(flat, scenario.grid_shape[1])
-    seers = [s for s in world.seers_of((col + 0.5) * cell, (row + 0.5) * cell)[:, 1:] if cell_of(s, cell) not in banned]
-    ways = np.array([(np.cos(a), np.sin(a)) for a in np.arange(8) * np.pi / 4])
-    groups = [np.vstack([np.zeros((1, 2)), SHIFT_SPREADS * face * ways])]
-    if dict(scenario.noise).get("localiser_sigma", 0.0) > 0.0:  # after the others: what they find is kept
-        groups.append(fine_rings(face))
-    ground = world.ground
-    stations = []
-    for offsets in groups:
-        for seer in seers[:SEERS_TRIED]:
-            for station in seer + offsets:
-                if not in_reachable_cell(world.reachable, *station, scenario.cell):
-                    continue  # a wide face radius (a noisy localiser's) shifts it off the team's space
-                if not in_sight(ground.wall_grid, *seer, *station, ground.grain, ground.plan_radius, ground.bounded):
-                    continue  # the disk with its clearance does not fit there: the filter would hold it short
-                stations.append(station)
-    reaches: dict[int, bool] = {}  # whether a place's own stare reaches the cell: else no spread's can
-    for spread in SEER_SPREADS:  # the places tried once, over each spread in turn
-        for index, station in enumerate(stations):
-            if index not in reaches:
-                reaches[index] = bool(deposit.stares(station[None, :], ANGLES)[flat].sum() > 0.0)
-            if not reaches[index]:
-                continue
-            stares = deposit.sure_stares(station[None, :], ANGLES, spread * face)
-            if stares[flat].sum() > 0.0:
-                return station, stares
-    return None
-
-
-def fine_rings(face: float) -> np.ndarray:
-    """(M, 2) the offsets of :data:`FINE_RINGS`' points from a seer's centre, ring by ring, less the 8 of the ring
-    :data:`SHIFT_SPREADS` off (tried before them: tried again, they would find nothing new)."""
-    rings = [np.zeros((0, 2))]
-    for ring in range(1, FINE_RINGS + 1):
-        steps = np.arange(8 * ring)
-        if ring == SHIFT_SPREADS:
-            steps = steps[steps % ring != 0]  # the 8 ways every 45°
-        angles = steps * 2.0 * np.pi / (8 * ring)
-        rings.append(ring * face * np.stack([np.cos(angles), np.sin(angles)], axis=1))
-    return np.vstack(rings)
-
-
-def cell_of(point: np.ndarray, cell: float) -> tuple[int, int]:
-    """(row, col) of the cell about ``point``."""
-    return int(point[1] // cell), int(point[0] // cell)
 
 
 def cleanup_pieces(

@@ -27,7 +27,6 @@ import numpy as np
 from model.controllers.anicov.deposit import Deposit
 from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop, arrive_radius_of, face_radius_of
 from model.controllers.anicov.terrain_cleanup import (
-    cell_of,
     cleanup_pieces,
     cleanup_stations,
     left_near,
@@ -36,8 +35,16 @@ from model.controllers.anicov.terrain_cleanup import (
 )
 from model.controllers.anicov.terrain_lanes import free_path, piece_route
 from model.controllers.anicov.terrain_relief import aside, in_the_way, relief
+from model.controllers.anicov.terrain_seers import cell_of
 from model.controllers.anicov.terrain_stations import ANGLES, deposit_among_walls
-from model.controllers.anicov.terrain_turns import MOST_WAIT_PLANS, next_station, station_gap, wait_carrot, who_waits
+from model.controllers.anicov.terrain_turns import (
+    MOST_WAIT_PLANS,
+    aside_carrot,
+    next_station,
+    station_gap,
+    wait_carrot,
+    who_waits,
+)
 from model.scenario import Scenario
 from model.scenario.physics_keys import pair_margin_of
 from model.world.world import world_of
@@ -118,8 +125,11 @@ class TerrainFlight:
             self.waited[agent] = self.waited.get(agent, 0) + 1
             if self.waited[agent] > MOST_WAIT_PLANS:
                 continue
-            blockers = [next_station(routes[ids[other]]) for other in waits[index]]
-            self.held[agent] = wait_carrot(routes[agent], positions[index], blockers, gap, face, approach)
+            ways = [routes[ids[other]] for other in waits[index]]
+            aside_at = aside_carrot(world_of(scenario), positions[index], ways, gap, approach)
+            blockers = [next_station(way) for way in ways]
+            held = wait_carrot(routes[agent], positions[index], blockers, gap, face, approach)
+            self.held[agent] = held if aside_at is None else aside_at
 
     def patch(self, routes: dict[int, Route], agent: int, lack: np.ndarray) -> None:
         """The robot has just faced its station's last bearing: a stop where it stands with the bearings that

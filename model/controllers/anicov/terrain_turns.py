@@ -13,12 +13,16 @@ N = 10, seed 1, physics: about 15 time units).
   within the gap of the teammate's station in the coming plan period; farther off it flies on, as the teammate may
   be gone by the time it arrives. The way left along the route, not the straight line, ranks them: it never grows,
   so two robots round a pillar do not swap. A robot standing on the teammate's way to its station does not wait
-  there: it would hold the teammate it waits for. The first robot of every such group goes, so some robot always
+  there: it would hold the teammate it waits for, and going it clears the way. Where each stands on the other's
+  way (both near stations nearer than the gap), going holds both for good, so the one ranked second waits, out of
+  the way (the MRPT lab, N = 10, seed 7, the issue's noise: two robots 0.11 and 0.14 m off stations 0.3 m apart
+  held each other and two teammates waiting for them from t = 282 to 584). The first robot of every such group goes, so some robot always
   goes; and a robot waits at most :data:`MOST_WAIT_PLANS` plans in a row (two planners that differ about a teammate,
   with a limited radio, could each make their own robot wait).
 - **Where it waits** (:func:`wait_carrot`): where it stands, facing its station, when it is at least the gap from
   every station it waits for; else back along its own route, a plan period's way at a time, to the nearest point
-  that far; where there is none, where it stands.
+  that far; where there is none, where it stands. A robot on a teammate's way steps aside to wait
+  (:func:`aside_carrot`), as a robot with nothing to do does.
 
 The rule is the planner's, pure, so the coordinator's carrots are the engine's; it changes nothing where no two
 next stations are that near.
@@ -31,9 +35,11 @@ import math
 import numpy as np
 
 from model.controllers.anicov.route import Route
-from model.controllers.anicov.terrain_relief import in_the_way
+from model.controllers.anicov.terrain_lanes import free_path
+from model.controllers.anicov.terrain_relief import aside, in_the_way
 from model.scenario import Scenario
 from model.scenario.physics_keys import pair_margin_of
+from model.world.world import World
 
 MOST_WAIT_PLANS = 120
 """The most plans in a row a robot waits its turn (60 time units): longer than a teammate's longest cleanup station
@@ -70,11 +76,37 @@ def who_waits(
             and float(np.hypot(*(there - place))) < gap
             and float(np.hypot(*(there - positions[index]))) < gap + approach
             and (left[other], ids[other]) < (left[index], ids[index])
-            and not in_the_way(routes[ids[other]], positions[index], gap, spacing)
+            and not _holds_only(routes, positions, ids, (index, other), (gap, spacing))
         ]
         if first:
             waits[index] = first
     return waits
+
+
+def _holds_only(
+    routes: dict[int, Route], positions: np.ndarray, ids: list[int], pair: tuple[int, int], reach: tuple[float, float]
+) -> bool:
+    """Whether the robot ``pair[0]`` stands on the way of ``pair[1]`` to its station while that one does not stand
+    on its own (``reach``: the gap and the test's spacing): going, it clears the way (:func:`who_waits`)."""
+    index, other = pair
+    gap, spacing = reach
+    return in_the_way(routes[ids[other]], positions[index], gap, spacing) and not in_the_way(
+        routes[ids[index]], positions[other], gap, spacing
+    )
+
+
+def aside_carrot(
+    world: World, position: np.ndarray, blockers: list[Route], gap: float, step: float
+) -> np.ndarray | None:
+    """The carrot of a robot at ``position`` that waits for teammates on whose ways (``blockers``, each up to its
+    next stop) it stands: ``step`` along the free path to where it stands out of them
+    (:func:`model.controllers.anicov.terrain_relief.aside`); None where there is no such place."""
+    if not any(in_the_way(route, position, gap, 0.5 * world.scenario.cell) for route in blockers):
+        return None
+    place = aside(world, position, blockers, gap)
+    if place is None:
+        return None
+    return Route.of(free_path(world, np.asarray(position, dtype=np.float64), place)).point_at(step)
 
 
 def wait_carrot(
