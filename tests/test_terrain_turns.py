@@ -9,6 +9,7 @@ import pytest
 
 from anicov.engine import run_scenario
 from model.controllers.anicov.route import CARROT_PERIOD, Route, Stop, face_radius_of
+from model.controllers.anicov.terrain_flight import TerrainFlight
 from model.controllers.anicov.terrain_relief import aside
 from model.controllers.anicov.terrain_turns import aside_carrot, station_gap, wait_carrot, who_waits
 from model.scenario import load_scenario
@@ -113,17 +114,25 @@ def test_the_lab_run_two_pairs_of_neighbouring_stations_held_now_completes():
 
 
 def test_two_robots_each_on_the_other_s_way_take_turns_and_the_second_steps_aside():
-    """Two robots 0.11 and 0.14 off their stations 0.3 apart (the MRPT lab, N = 10, seed 7, with noise): each stands
-    on the other's way, so going held both for good. Now the lower id goes and the other waits out of both ways."""
+    """Two robots held off stations nearer than the gap, each on the other's way (the MRPT lab, N = 10, seed 7, with
+    noise: 0.11 and 0.14 m off stations 0.3 m apart): before, neither waited, and the filter held both for good. Now
+    the one nearer its station goes (both have come to their stations: the way left ties at 0, and the straight line
+    ranks them before the id), and the other steps aside along the free path (the flight's carrot for it)."""
     gap = station_gap(ROOMS)
-    routes = {0: route_to([6.0, 8.4], [6.3, 8.5]), 7: route_to([6.7, 8.2], [6.6, 8.5])}
-    positions = np.array([[6.19, 8.46], [6.63, 8.36]])
+    routes = {0: route_to([5.0, 8.5], [6.0, 8.5]), 7: route_to([8.0, 8.5], [7.0, 8.5])}
+    positions = np.array([[5.7, 8.5], [7.2, 8.5]])  # 0.3 and 0.2 off; disks (r = 0.4) 1.5 apart
     for route in routes.values():
-        route.progress = route.length  # held off its station, at the end of its route
-    assert who_waits(routes, positions, [0, 7], gap, APPROACH, SPACING) == {1: [0]}
+        route.progress = route.length  # come to its station: progress never passes a stop not yet done
+    assert (
+        np.hypot(*(positions[0] - [7.0, 8.5])) < gap and np.hypot(*(positions[1] - [6.0, 8.5])) < gap
+    )  # each on the other's way
+    assert who_waits(routes, positions, [0, 7], gap, APPROACH, SPACING) == {0: [1]}  # robot 7 is nearer: 0 waits
     world = world_of(ROOMS)
-    carrot = aside_carrot(world, positions[1], [routes[0]], gap, APPROACH)
-    assert carrot is not None and np.hypot(*(carrot - positions[1])) == pytest.approx(APPROACH, abs=1e-6)
-    place = aside(world, positions[1], [routes[0]], gap)
-    assert np.hypot(*(place - np.array([6.3, 8.5]))) >= 1.5 * gap  # out of robot 0's way to its station
-    assert aside_carrot(world, np.array([6.5, 3.0]), [routes[0]], gap, APPROACH) is None  # not on its way: no step
+    carrot = aside_carrot(world, positions[0], [routes[7]], gap, APPROACH)
+    assert carrot is not None and np.hypot(*(carrot - positions[0])) == pytest.approx(APPROACH, abs=1e-6)
+    place = aside(world, positions[0], [routes[7]], gap)
+    assert np.hypot(*(place - positions[0])) > np.hypot(*(carrot - positions[0]))  # a step on the way there
+    flight = TerrainFlight(ROOMS)
+    flight.take_turns(routes, positions, [0, 7])
+    assert set(flight.held) == {0} and np.allclose(flight.held[0], carrot)
+    assert aside_carrot(world, np.array([2.5, 2.5]), [routes[7]], gap, APPROACH) is None  # not on its way: no step

@@ -9,7 +9,8 @@ lab, N = 1: 32 cells left when the tour ended took 900 of the run's 3,300 time u
   robots' routes will add (:class:`model.controllers.anicov.deposit.Deposit`'s stares and legs, the
   programme's model), so that a free robot does not clean up what a teammate is about to see.
 - **The stations** (:func:`cleanup_stations`): the reachable cells within R of a short cell, every
-  :data:`CANDIDATE_STRIDE`-th row and column, plus a seer of its own for a short cell none of them sees; the
+  :data:`CANDIDATE_STRIDE`-th row and column, plus a seer of its own for a short cell none of them sees (with a
+  localiser's noise, or sees too little for :data:`MOST_PERIODS`: :mod:`model.controllers.anicov.terrain_seers`); the
   least periods of their stares that bring each short cell :data:`CLEANUP_DEMAND` of its lack (the relaxed
   programme, then whole periods: :func:`model.controllers.anicov.stations.whole_periods`).
 - **Who flies them** (:func:`cleanup_pieces`): the stations in a tour by free-path length from the one nearest

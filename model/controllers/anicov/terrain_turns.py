@@ -8,15 +8,16 @@ point toward the other and is held too, and the deadlock's detours take both awa
 lab, N = 10, seed 4, kinematic: two such pairs from t = 50 to the end, 400 deadlocks, a cell given up; two rooms,
 N = 10, seed 1, physics: about 15 time units).
 
-- **Who waits** (:func:`who_waits`): a robot whose next station is within the gap of a teammate's next station
-  waits when that teammate has less of its route left to its own (ties: the lower id goes first), once it would come
-  within the gap of the teammate's station in the coming plan period; farther off it flies on, as the teammate may
-  be gone by the time it arrives. The way left along the route, not the straight line, ranks them: it never grows,
-  so two robots round a pillar do not swap. A robot standing on the teammate's way to its station does not wait
-  there: it would hold the teammate it waits for, and going it clears the way. Where each stands on the other's
-  way (both near stations nearer than the gap), going holds both for good, so the one ranked second waits, out of
-  the way (the MRPT lab, N = 10, seed 7, the issue's noise: two robots 0.11 and 0.14 m off stations 0.3 m apart
-  held each other and two teammates waiting for them from t = 282 to 584). The first robot of every such group goes, so some robot always
+- **Who waits** (:func:`who_waits`): a robot whose next station is within the gap of a teammate's next station waits
+  when that teammate has less of its route left to its own (ties, as between two robots that have both come to their
+  stations: the one nearer its own in a straight line, then the lower id), once it would come within the gap of the
+  teammate's station in the coming plan period; farther off it flies on, as the teammate may be gone by the time it
+  arrives. The way left along the route, not the straight line, ranks them: it never grows, so two robots round a
+  pillar do not swap. A robot standing on the teammate's way to its station does not wait there: it would hold the
+  teammate it waits for, and going it clears the way. Where each stands on the other's way (both near stations
+  nearer than the gap), going holds both for good, so the one ranked second waits, out of the way (the MRPT lab,
+  N = 10, seed 7, the issue's noise: two robots 0.11 and 0.14 m off stations 0.3 m apart held each other and two
+  teammates waiting for them from t = 282 to 584). The first robot of every such group goes, so some robot always
   goes; and a robot waits at most :data:`MOST_WAIT_PLANS` plans in a row (two planners that differ about a teammate,
   with a limited radio, could each make their own robot wait).
 - **Where it waits** (:func:`wait_carrot`): where it stands, facing its station, when it is at least the gap from
@@ -67,6 +68,9 @@ def who_waits(
     stations = {index: next_station(routes[agent]) for index, agent in enumerate(ids)}
     ahead = {index: place for index, place in stations.items() if place is not None}
     left = {index: routes[ids[index]].stops[0].at - routes[ids[index]].progress for index in ahead}
+    rank = {
+        index: (left[index], float(np.hypot(*(place - positions[index]))), ids[index]) for index, place in ahead.items()
+    }
     waits: dict[int, list[int]] = {}
     for index, place in ahead.items():
         first = [
@@ -75,7 +79,7 @@ def who_waits(
             if other != index
             and float(np.hypot(*(there - place))) < gap
             and float(np.hypot(*(there - positions[index]))) < gap + approach
-            and (left[other], ids[other]) < (left[index], ids[index])
+            and rank[other] < rank[index]
             and not _holds_only(routes, positions, ids, (index, other), (gap, spacing))
         ]
         if first:
@@ -100,7 +104,8 @@ def aside_carrot(
 ) -> np.ndarray | None:
     """The carrot of a robot at ``position`` that waits for teammates on whose ways (``blockers``, each up to its
     next stop) it stands: ``step`` along the free path to where it stands out of them
-    (:func:`model.controllers.anicov.terrain_relief.aside`); None where there is no such place."""
+    (:func:`model.controllers.anicov.terrain_relief.aside`); None where it stands on none of them, or there is no
+    such place (it waits as :func:`wait_carrot` says)."""
     if not any(in_the_way(route, position, gap, 0.5 * world.scenario.cell) for route in blockers):
         return None
     place = aside(world, position, blockers, gap)
