@@ -40,6 +40,9 @@ def test_a_robot_done_takes_the_end_of_the_longest_route_and_every_stop_is_kept_
     taken = [given.taken.point_at(stop.at).tolist() for stop in given.taken.stops]
     assert kept + taken == before and kept and taken
     assert np.allclose(given.taken.points[0], [3.5, 12.5])  # from where the reliever stands
+    last = given.kept.stops[-1].at  # the robot relieved ends at its last stop, not at the reliever's first
+    assert given.kept.length == pytest.approx(last)
+    assert given.kept.length < routes[0].stops[len(given.kept.stops)].at
     end = max(time_left(given.kept, ROOMS.k_v), time_left(given.taken, ROOMS.k_v))
     assert end <= time_left(routes[0], ROOMS.k_v) - RELIEF_GAIN * 0.5
 
