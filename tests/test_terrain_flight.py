@@ -1,13 +1,17 @@
 """model.controllers.anicov.terrain_flight: a station left with cells short gets a patch (and a patch none), a
 robot done goes to clean up what nobody will stare at or stays, and a cleanup that took nothing has its
-stations banned."""
+stations banned; the noisy lab's last misses complete (slow)."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+from anicov.engine import run_scenario
 from model.controllers.anicov.route import Route, Stop
 from model.controllers.anicov.terrain_flight import TerrainFlight
+from model.scenario import load_scenario
+from tests.test_real_maps import REAL, map_of
 from tests.test_terrain_cleanup import short_spots
 from tests.test_terrain_stations import ROOMS
 
@@ -81,3 +85,27 @@ def test_anicov_flies_two_robots_with_bodies_and_the_filter_through_the_rooms_to
     paper = run_scenario(scenario.with_overrides(controller="paper"), record_trace=False)
     # Measured (seed 0): 299.6 against the paper's law's 431.2.
     assert result.completion_time < paper.completion_time
+
+
+NOISE = {
+    "odometry_per_metre": 0.01, "odometry_per_radian": 0.01, "localiser_sigma": 0.05, "localiser_heading_deg": 2.0,
+    "localiser_rate": 10.0, "localiser_latency": 0.1, "command_latency": 0.1,
+}  # fmt: skip
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("agents, seed", [(10, 0), (10, 6), (10, 7), (4, 1)])
+def test_the_noisy_lab_s_last_misses_complete_without_their_long_stands(agents, seed):
+    """Issue 37's study on MRPT's lab with the issue's noise (docs/physics.md, "The last misses at N = 10"): N = 10
+    seeds 6 and 7 gave a cell up, seed 0 took 601.3 (a cleanup station stared 710 periods), N = 4 seed 1 took 1,012.1
+    (a relieved robot jammed in a pocket). Each completes, with no cell given up, in under 1.5 times the study's
+    kinematic mean (258.7 at N = 10, 592.8 at N = 4); they now take 276.6, 281.6, 283.1 and 853.3."""
+    scenario_path = REAL / "uwb-lab.toml"
+    map_of(scenario_path)
+    scenario = load_scenario(scenario_path).with_overrides(
+        agents=agents, seed=seed, controller="anicov", physics="mujoco", noise=NOISE, max_time=2000.0
+    )
+    result = run_scenario(scenario, record_trace=False)
+    kinematic_mean = {10: 258.7, 4: 592.8}[agents]
+    assert result.completed and not result.given_up.any()
+    assert result.completion_time < 1.5 * kinematic_mean
