@@ -99,7 +99,7 @@ def test_the_noisy_lab_s_last_misses_complete_without_their_long_stands(agents, 
     """Issue 37's study on MRPT's lab with the issue's noise (docs/physics.md, "The last misses at N = 10"): N = 10
     seeds 6 and 7 gave a cell up, seed 0 took 601.3 (a cleanup station stared 710 periods), N = 4 seed 1 took 1,012.1
     (a relieved robot jammed in a pocket). Each completes, with no cell given up, in under 1.5 times the study's
-    kinematic mean (258.7 at N = 10, 592.8 at N = 4); they now take 276.6, 281.6, 283.1 and 853.3."""
+    kinematic mean (258.7 at N = 10, 592.8 at N = 4); they now take 276.6, 282.1, 286.6 and 853.3."""
     scenario_path = REAL / "uwb-lab.toml"
     map_of(scenario_path)
     scenario = load_scenario(scenario_path).with_overrides(

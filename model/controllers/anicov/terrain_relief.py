@@ -30,7 +30,8 @@ RELIEF_GAIN = 4.0
 
 @dataclass(frozen=True)
 class Relief:
-    """The robot relieved, what it keeps (its route up to the cut) and the reliever's route from where it stands."""
+    """The robot relieved, what it keeps (its route up to its last stop before the cut) and the reliever's route from
+    where it stands."""
 
     relieved: int
     kept: Route
@@ -76,7 +77,7 @@ def relief(world: World, routes: dict[int, Route], busy: list[int], position: np
 
 def _cut(world: World, route: Route, j: int, behind: int, position: np.ndarray) -> Relief:
     """The routes of a relief cut before stop ``j`` of ``route``: the robot relieved keeps its route up to its last
-    stop before the cut. Driven on to the cut, the reliever's first station, it had nothing left to do there and
+    stop before the cut. Driven on to the cut, the reliever's first stop, it had nothing left to do there and
     stood in the reliever's way (the MRPT lab with the issue's noise, N = 4, seed 1: with an idle robot stepping
     aside, three robots jammed in a pocket by a wall from t = 685 to 1,010; 1,012.1 -> 853.3). What the hops between
     that stop and the cut would have seen is left to the cleanup. (:func:`relief` still times the robot relieved
