@@ -118,6 +118,12 @@ def belief_sigma_of(scenario: Any) -> float:
     return math.sqrt(position + (period + delay) / period * position_q)
 
 
+def localiser_sigma_of(scenario: Any) -> float:
+    """The localiser's σ in position (``localiser_sigma``), 0 without one: what the planner's rules for a noisy
+    localiser (the face radius, the seer search, the cleanup's cap) read."""
+    return float(dict(scenario.noise).get("localiser_sigma", 0.0))
+
+
 def localiser_steps_of(scenario: Any) -> tuple[int, int]:
     """(control periods between two fixes, 0 without a localiser; periods from the pose a fix measures to its
     arrival): ``localiser_rate`` and ``localiser_latency`` in whole periods, as the belief

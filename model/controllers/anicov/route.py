@@ -15,6 +15,7 @@ import numpy as np
 from numba import njit
 
 from model.scenario import Scenario
+from model.scenario.physics_keys import localiser_sigma_of
 
 CARROT_PERIOD = 0.5
 """Time units between two carrots of one robot (:mod:`model.controllers.anicov.lane_planner`): the anicov
@@ -56,7 +57,7 @@ def face_radius_of(scenario: Scenario) -> float:
     face = FACE_RADIUS * scenario.k_v * scenario.dt / 0.1  # among walls, at the robot's units: half a step
     noise = dict(scenario.noise)
     late = LATENCY_FACE_TRAVEL * scenario.k_v * noise.get("command_latency", 0.0)
-    return max(face, NOISE_FACE_SIGMAS * noise.get("localiser_sigma", 0.0), late)
+    return max(face, NOISE_FACE_SIGMAS * localiser_sigma_of(scenario), late)
 
 
 LATENCY_FACE_TRAVEL = 2.0

@@ -38,6 +38,7 @@ from model.controllers.anicov.terrain_seers import SURE_SPREADS, with_seers
 from model.controllers.anicov.terrain_stations import ANGLES
 from model.planning import path_lengths
 from model.scenario import Scenario
+from model.scenario.physics_keys import localiser_sigma_of
 from model.world.world import World
 
 CLEANUP_DEMAND = 1.1
@@ -186,7 +187,7 @@ def _least_a_period(scenario: Scenario, wanted: np.ndarray) -> np.ndarray:
     candidates reach only at a wedge's rim, through the spread of a sure stare, was otherwise stared at for the
     relaxed programme's hundreds of periods (the MRPT lab, N = 10, seed 0: 710 periods at 0.0014 Λ*, 355 time
     units of a 601.3 run, where its own seer's stares bring 0.071)."""
-    if dict(scenario.noise).get("localiser_sigma", 0.0) > 0.0:
+    if localiser_sigma_of(scenario) > 0.0:
         return wanted / MOST_PERIODS
     return np.zeros_like(wanted)
 

@@ -126,10 +126,11 @@ class TerrainFlight:
             if self.waited[agent] > MOST_WAIT_PLANS:
                 continue
             ways = [routes[ids[other]] for other in waits[index]]
-            aside_at = aside_carrot(world_of(scenario), positions[index], ways, gap, approach)
-            blockers = [next_station(way) for way in ways]
-            held = wait_carrot(routes[agent], positions[index], blockers, gap, face, approach)
-            self.held[agent] = held if aside_at is None else aside_at
+            held = aside_carrot(world_of(scenario), positions[index], ways, gap, approach)
+            if held is None:
+                blockers = [next_station(way) for way in ways]
+                held = wait_carrot(routes[agent], positions[index], blockers, gap, face, approach)
+            self.held[agent] = held
 
     def patch(self, routes: dict[int, Route], agent: int, lack: np.ndarray) -> None:
         """The robot has just faced its station's last bearing: a stop where it stands with the bearings that

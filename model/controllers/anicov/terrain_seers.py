@@ -15,6 +15,7 @@ from scipy.sparse import csc_matrix, hstack
 from model.controllers.anicov.deposit import Deposit
 from model.controllers.anicov.route import face_radius_of
 from model.controllers.anicov.terrain_stations import ANGLES
+from model.scenario.physics_keys import localiser_sigma_of
 from model.world.geodesic import in_sight
 from model.world.reachability import in_reachable_cell
 from model.world.world import World
@@ -60,7 +61,7 @@ def with_seers(
     stations, stares = candidates
     brought = best_bearings(stares)
     tried = np.zeros(brought.shape, dtype=bool)
-    waiting = np.flatnonzero(short.ravel() & ((brought <= 0.0) | (brought < least)))
+    waiting = np.flatnonzero(short.ravel() & _wants_a_seer(brought, least))
     added, blocks = [], [stares]
     while len(waiting):
         flat = int(waiting[0])
@@ -70,8 +71,14 @@ def with_seers(
             blocks.append(found[1])
             brought = brought + best_bearings(found[1])
         tried[flat] = True  # tried once
-        waiting = waiting[~tried[waiting] & ((brought[waiting] <= 0.0) | (brought[waiting] < least[waiting]))]
+        waiting = waiting[~tried[waiting] & _wants_a_seer(brought[waiting], least[waiting])]
     return np.vstack([stations.reshape(-1, 2), *added]), hstack(blocks).tocsc()
+
+
+def _wants_a_seer(brought: np.ndarray, least: np.ndarray) -> np.ndarray:
+    """Whether cells whose stations bring ``brought`` a period (:func:`best_bearings`) want a seer of their own:
+    where nothing reaches them, or less than ``least`` does."""
+    return (brought <= 0.0) | (brought < least)
 
 
 def best_bearings(stares: csc_matrix) -> np.ndarray:
@@ -130,7 +137,7 @@ def seer_places(world: World, flat: int, banned: frozenset[tuple[int, int]]) -> 
     seers = [s for s in world.seers_of((col + 0.5) * cell, (row + 0.5) * cell)[:, 1:] if cell_of(s, cell) not in banned]
     ways = np.array([(np.cos(a), np.sin(a)) for a in np.arange(8) * np.pi / 4])
     groups = [np.vstack([np.zeros((1, 2)), SHIFT_SPREADS * face * ways])]
-    if dict(scenario.noise).get("localiser_sigma", 0.0) > 0.0:  # after the others: what they find is kept
+    if localiser_sigma_of(scenario) > 0.0:  # after the others: what they find is kept
         groups.append(fine_rings(face))
     ground = world.ground
     places = []
