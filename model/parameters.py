@@ -40,7 +40,10 @@ def coverage_map_of(scenario: Scenario, with_margin: bool = True) -> CoverageMap
     coverage_map = CoverageMap(rows, cols, scenario.cell, scenario.lambda_star * (1.0 + margin))
     world = world_of(scenario)
     if not world.open or scenario.priority_map:
-        coverage_map.start_from(world.head_start(coverage_map.target_ticks, 1.0 + margin))
+        start = world.head_start(coverage_map.target_ticks, 1.0 + margin)
+        if with_margin:  # the team does not ask what it cannot surely see; the truth's map still counts it
+            start[world.unsure] = coverage_map.target_ticks
+        coverage_map.start_from(start)
     return coverage_map
 
 

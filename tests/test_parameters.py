@@ -7,10 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from model.parameters import free_initial_poses, initial_poses
+from model.parameters import coverage_map_of, free_initial_poses, initial_poses
 from model.scenario import Scenario
 from model.scenario.terrain import load_occupancy_map, map_on_grid
 from model.world.clearance import disk_is_free
+from model.world.world import world_of
 from tests.conftest import ROOT
 
 
@@ -37,3 +38,24 @@ def test_a_team_too_big_for_its_free_space_is_refused():
     assert free_initial_poses(occupied, 1.0, agents=1, seed=0, radius=0.5, clearance=0.2).shape == (1, 3)
     with pytest.raises(ValueError, match=r"cannot hold 2 robots of radius 0\.5"):
         free_initial_poses(occupied, 1.0, agents=2, seed=0, radius=0.5, clearance=0.2)
+
+
+ISSUE_NOISE = {
+    "odometry_per_metre": 0.01, "odometry_per_radian": 0.01, "localiser_sigma": 0.05, "localiser_heading_deg": 2.0,
+    "localiser_rate": 10.0, "localiser_latency": 0.1, "command_latency": 0.1,
+}  # fmt: skip
+
+
+def test_a_noisy_team_does_not_ask_the_lab_s_cell_seen_through_a_gap_and_the_truth_still_counts_it():
+    """MRPT's lab (a public SLAM map): cell (40, 53) is seen from its only seer's centre and from no point 0.027
+    off it (issue 37: a cleanup there took nothing, and the watchdog gave the cell up)."""
+    from model.scenario import load_scenario
+    from tests.test_real_maps import REAL, map_of
+
+    map_of(REAL / "uwb-lab.toml")
+    lab = load_scenario(REAL / "uwb-lab.toml").with_overrides(physics="mujoco", noise=ISSUE_NOISE)
+    team, truth = coverage_map_of(lab), coverage_map_of(lab, with_margin=False)
+    assert team.coverage[40, 53] == team.target_ticks and truth.coverage[40, 53] == 0
+    assert truth.counted_cells - team.counted_cells == int(world_of(lab).unsure.sum()) <= 5
+    exact = lab.with_overrides(noise={})  # without noise every coverable cell is asked
+    assert coverage_map_of(exact).coverage[40, 53] == 0 and not world_of(exact).unsure.any()

@@ -1,4 +1,5 @@
-"""model.world.reachability: an enclosed room and a pocket narrower than the robot cannot be covered."""
+"""model.world.reachability: an enclosed room and a pocket narrower than the robot cannot be covered; a cell seen
+only through a gap narrower than the noise is unsure."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ import numpy as np
 
 from model.scenario.terrain import load_occupancy_map, map_on_grid
 from model.world.geodesic import passable_cells
-from model.world.reachability import coverable_cells, nearest_reachable, reachable_cells
+from model.world.reachability import coverable_cells, nearest_reachable, reachable_cells, unsure_cells
 from tests.conftest import ROOT
 
 
@@ -50,3 +51,29 @@ def test_a_point_past_the_edge_of_a_reachable_border_cell_is_moved_onto_the_grid
     assert moved[0].tolist() == [14.5, 15.5]
     assert moved[1].tolist() == [0.5, 5.5]
     assert moved[2].tolist() == [3.0, 4.0]  # x / cell on a cell's edge: its own cell, reachable
+
+
+def gap_in_a_wall() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cells of 1 on six rows of three, walls in squares of 0.1: a wall fills row 2 but for a gap 0.2 wide about
+    x = 1.5. The robots reach rows 0 and 1; rows 3 to 5 are seen only through the gap. (wall_grid, reachable,
+    coverable)."""
+    wall_grid = np.zeros((60, 30), dtype=bool)
+    wall_grid[20:30, :] = True
+    wall_grid[20:30, 14:16] = False
+    reachable = np.zeros((6, 3), dtype=bool)
+    reachable[:2] = True
+    coverable = np.ones((6, 3), dtype=bool)
+    coverable[2] = False
+    return wall_grid, reachable, coverable
+
+
+def test_a_cell_seen_only_through_a_gap_narrower_than_the_spread_is_unsure_and_one_seen_wide_is_not():
+    wall_grid, reachable, coverable = gap_in_a_wall()
+    wide = unsure_cells(wall_grid, 0.1, reachable, coverable, 5.0, 1.0, 0.5)
+    assert wide[4, 1] and wide[3, 1]  # from 0.5 off any reachable centre the gap is missed
+    assert not wide[:2].any()  # a reachable cell sees itself
+    narrow = unsure_cells(wall_grid, 0.1, reachable, coverable, 5.0, 1.0, 0.05)
+    assert not narrow[4, 1] and not narrow[3, 1]  # 0.05 off (1.5, 1.5) the line still passes the gap
+    assert not unsure_cells(wall_grid, 0.1, reachable, coverable, 5.0, 1.0, 0.0).any()  # no noise: none
+    open_room = np.zeros_like(wall_grid)
+    assert not unsure_cells(open_room, 0.1, reachable, coverable, 5.0, 1.0, 0.5).any()

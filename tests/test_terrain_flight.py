@@ -39,6 +39,22 @@ def test_leaving_a_station_with_cells_short_near_it_puts_a_patch_there_and_a_pat
     assert routes[0].stops == []
 
 
+def test_a_robot_whose_route_ends_at_the_station_it_leaves_keeps_its_patch():
+    """Its last bearing faced, its route is done, so the plan finds it free before the patch: the patch stands
+    and the robot is not sent to stand idle (it was, until 2026-12-08, and the patch was thrown away)."""
+    flight = TerrainFlight(ROOMS)
+    lack = short_spots([(8, 7), (8, 8)], 0.4)
+    route = Route.of(np.array([[6.5, 2.5], STATION]), stops=[Stop(6.0, [0.0])])
+    route.progress = route.length
+    routes = {0: route}
+    flight.steer(routes, lack, STATION[None, :], [0], [])  # at its last station, a bearing left
+    routes[0].stops = []  # faced: the route is done
+    flight.steer(routes, lack, STATION[None, :], [0], [0])
+    patch = routes[0].stops[0]
+    assert not routes[0].cleanup and patch.at == routes[0].progress == 6.0 and patch.bearings
+    assert 0 not in flight.idle and flight.patched[0] == 6.0
+
+
 def test_leaving_a_station_with_nothing_short_puts_no_patch():
     flight = TerrainFlight(ROOMS)
     routes = {0: at_station(1)}

@@ -71,6 +71,51 @@ def _seen_from(
     return seen
 
 
+@njit(cache=True)
+def _surely_seen(
+    wall_grid: np.ndarray, grain: float, reachable: np.ndarray, coverable: np.ndarray, sensing_range: float, cell: float,
+    spread: float,
+) -> np.ndarray:  # fmt: skip
+    """Coverable cells that some reachable cell sees from its centre and from the eight points ``spread`` off it
+    (every 45°), each closer than ``sensing_range`` less ``spread`` in clear sight; a reachable cell sees itself."""
+    rows, cols = coverable.shape
+    seen = reachable & coverable
+    span = math.ceil(sensing_range / cell)
+    for row in range(rows):
+        for col in range(cols):
+            if seen[row, col] or not coverable[row, col]:
+                continue
+            tx, ty = (col + 0.5) * cell, (row + 0.5) * cell
+            for r in range(max(row - span, 0), min(row + span + 1, rows)):
+                for c in range(max(col - span, 0), min(col + span + 1, cols)):
+                    x, y = (c + 0.5) * cell, (r + 0.5) * cell
+                    if not reachable[r, c] or math.hypot(tx - x, ty - y) + spread >= sensing_range:
+                        continue
+                    sure = not segment_crosses_occupied(wall_grid, x, y, tx, ty, grain)
+                    for way in range(8):
+                        if not sure:
+                            break
+                        u, v = math.cos(way * math.pi / 4), math.sin(way * math.pi / 4)
+                        sure = not segment_crosses_occupied(wall_grid, x + spread * u, y + spread * v, tx, ty, grain)
+                    if sure:
+                        seen[row, col] = True
+                        break
+                if seen[row, col]:
+                    break
+    return seen
+
+
+def unsure_cells(
+    wall_grid: np.ndarray, grain: float, reachable: np.ndarray, coverable: np.ndarray, sensing_range: float, cell: float,
+    spread: float,
+) -> np.ndarray:  # fmt: skip
+    """Coverable cells that no reachable cell sees surely over ``spread`` (:func:`_surely_seen`): seen only through
+    a gap between walls, from a point a robot must stand on to better than ``spread``. None where ``spread`` is 0."""
+    if spread <= 0.0:
+        return np.zeros_like(coverable)
+    return coverable & ~_surely_seen(wall_grid, grain, reachable, coverable, sensing_range, cell, spread)
+
+
 def coverable_cells(
     wall_grid: np.ndarray,
     passable: np.ndarray,

@@ -41,7 +41,7 @@ from model.paper.fixed_point import COVERAGE_SCALE
 from model.scenario import Scenario
 from model.scenario.map_file import load_map
 from model.scenario.map_fit import FittedMap, MapFrame, fit_to_cells
-from model.scenario.physics_keys import safety_margin_of
+from model.scenario.physics_keys import safety_margin_of, unsure_spread_of
 from model.scenario.terrain import (
     OccupancyMap,
     TerrainError,
@@ -51,7 +51,7 @@ from model.scenario.terrain import (
 )
 from model.world.geodesic import distance_fields, grid_graph, passable_cells, passage_graph
 from model.world.ground import PLANNING_MARGIN, Ground
-from model.world.reachability import coverable_cells, seers
+from model.world.reachability import coverable_cells, seers, unsure_cells
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,6 +104,17 @@ class World:
     @property
     def coverable_area(self) -> float:
         return float(self.coverable.sum()) * self.scenario.cell**2
+
+    @functools.cached_property
+    def unsure(self) -> np.ndarray:
+        """Coverable cells a robot cannot be sure to see with a localiser's noise: no reachable cell sees them from
+        every point within :func:`model.scenario.physics_keys.unsure_spread_of` of its centre (:func:`model.world.reachability.unsure_cells`). The
+        team's map does not ask them (:func:`model.parameters.coverage_map_of`); the truth's still counts them."""
+        scenario = self.scenario
+        return unsure_cells(
+            self.wall_grid, self.grain, self.reachable, self.coverable, viewing_range_of(scenario), scenario.cell,
+            unsure_spread_of(scenario),
+        )  # fmt: skip
 
     def head_start(self, target_ticks: int, scale: float = 1.0) -> np.ndarray:
         """Ticks every replica starts with: Λ* on cells nobody can cover, and Λ*_max − Λ*(x) on the

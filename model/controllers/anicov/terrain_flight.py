@@ -177,7 +177,9 @@ class TerrainFlight:
     def clean_up(
         self, routes: dict[int, Route], lack: np.ndarray, positions: np.ndarray, ids: list[int], free: list[int]
     ) -> None:
-        """The cleanup (see the module)."""
+        """The cleanup (see the module). ``free`` was found before this plan's patches: a robot given a patch or a
+        detour has its route again and is left out (else its patch is thrown away for a standing cleanup route)."""
+        free = [index for index in free if routes[ids[index]].done()]
         just_done = [index for index in free if ids[index] not in self.idle]
         for index in just_done:
             self._judge(ids[index], lack)
