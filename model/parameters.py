@@ -34,7 +34,8 @@ def coverage_map_of(scenario: Scenario, with_margin: bool = True) -> CoverageMap
     """A fresh map of the scenario's grid, started as its world says (:meth:`model.world.world.World.head_start`:
     cells nobody can cover are out of e_D; a priority map's cells start part-way). With noise
     (:func:`model.scenario.physics_keys.cover_margin_of`) the team's map asks (1 + ``cover_margin``) Λ* of every cell, whichever process
-    keeps it; ``with_margin=False``: Λ*, the truth's map."""
+    keeps it, but for the cells it cannot surely see (:attr:`model.world.world.World.unsure`), which it does not
+    ask; ``with_margin=False``: Λ* of every coverable cell, the truth's map."""
     rows, cols = scenario.grid_shape
     margin = cover_margin_of(scenario) if with_margin else 0.0
     coverage_map = CoverageMap(rows, cols, scenario.cell, scenario.lambda_star * (1.0 + margin))

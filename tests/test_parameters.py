@@ -47,8 +47,9 @@ ISSUE_NOISE = {
 
 
 def test_a_noisy_team_does_not_ask_the_lab_s_cell_seen_through_a_gap_and_the_truth_still_counts_it():
-    """MRPT's lab (a public SLAM map): cell (40, 53) is seen from its only seer's centre and from no point 0.027
-    off it (issue 37: a cleanup there took nothing, and the watchdog gave the cell up)."""
+    """MRPT's lab (a public SLAM map): cell (40, 53) is seen from its only seer's centre and not from 2 belief-σ
+    (0.018 m) off it (issue 37: a cleanup that stood 0.027 m off took nothing, and the watchdog gave the cell up).
+    ``unsure_sigmas = 0`` asks it again."""
     from model.scenario import load_scenario
     from tests.test_real_maps import REAL, map_of
 
@@ -57,5 +58,7 @@ def test_a_noisy_team_does_not_ask_the_lab_s_cell_seen_through_a_gap_and_the_tru
     team, truth = coverage_map_of(lab), coverage_map_of(lab, with_margin=False)
     assert team.coverage[40, 53] == team.target_ticks and truth.coverage[40, 53] == 0
     assert truth.counted_cells - team.counted_cells == int(world_of(lab).unsure.sum()) <= 5
+    asked = lab.with_overrides(noise={**ISSUE_NOISE, "unsure_sigmas": 0.0})
+    assert coverage_map_of(asked).coverage[40, 53] == 0 and world_of(lab).summary()["unsure_cells"] >= 1
     exact = lab.with_overrides(noise={})  # without noise every coverable cell is asked
     assert coverage_map_of(exact).coverage[40, 53] == 0 and not world_of(exact).unsure.any()

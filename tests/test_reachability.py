@@ -55,15 +55,15 @@ def test_a_point_past_the_edge_of_a_reachable_border_cell_is_moved_onto_the_grid
 
 def gap_in_a_wall() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cells of 1 on six rows of three, walls in squares of 0.1: a wall fills row 2 but for a gap 0.2 wide about
-    x = 1.5. The robots reach rows 0 and 1; rows 3 to 5 are seen only through the gap. (wall_grid, reachable,
-    coverable)."""
+    x = 1.5. The robots reach rows 0 and 1; the cells of column 1 above the wall are seen only through the gap.
+    (wall_grid, reachable, coverable)."""
     wall_grid = np.zeros((60, 30), dtype=bool)
     wall_grid[20:30, :] = True
     wall_grid[20:30, 14:16] = False
     reachable = np.zeros((6, 3), dtype=bool)
     reachable[:2] = True
-    coverable = np.ones((6, 3), dtype=bool)
-    coverable[2] = False
+    coverable = reachable.copy()
+    coverable[3:, 1] = True
     return wall_grid, reachable, coverable
 
 

@@ -3,8 +3,9 @@
 
 :class:`PhysicalTeam` holds the MuJoCo world (:class:`model.physics.world.PhysicsWorld`), the commands in
 flight to the wheels (``command_latency``, :class:`model.physics.noise.CommandDelay`), and the coverage the
-cameras really gave: by eq. 2 from the true poses, on a map of its own at Λ* (the team's own map may ask more,
-``cover_margin``, and take less, ``sure_sigmas``). What a robot believes of its pose is not here: the
+cameras really gave: by eq. 2 from the true poses, on a map of its own at Λ* of every coverable cell (the team's
+own map may ask more, ``cover_margin``, take less, ``sure_sigmas``, and not ask the cells it cannot surely see,
+``unsure_sigmas``). What a robot believes of its pose is not here: the
 engine keeps :class:`model.physics.noise.Belief`, the simulator publishes odometry and fixes.
 """
 

@@ -107,8 +107,8 @@ class World:
 
     @functools.cached_property
     def unsure(self) -> np.ndarray:
-        """Coverable cells a robot cannot be sure to see with a localiser's noise: no reachable cell sees them from
-        every point within :func:`model.scenario.physics_keys.unsure_spread_of` of its centre (:func:`model.world.reachability.unsure_cells`). The
+        """Coverable cells a robot cannot be sure to see with a localiser's noise: no reachable cell sees them from its
+        centre and from the eight points :func:`model.scenario.physics_keys.unsure_spread_of` off it (:func:`model.world.reachability.unsure_cells`). The
         team's map does not ask them (:func:`model.parameters.coverage_map_of`); the truth's still counts them."""
         scenario = self.scenario
         return unsure_cells(
@@ -165,6 +165,8 @@ class World:
             "coverable_cells": int(self.coverable.sum()),
             "occupied_cells": int(self.occupied.sum()),
         }
+        if unsure := int(self.unsure.sum()):  # asked of the truth, not of the noisy team (coverage_map_of)
+            report["unsure_cells"] = unsure
         if self.map_sha256:
             report["map_sha256"] = self.map_sha256
         if self.priority_sha256:
