@@ -158,7 +158,7 @@ def command_maps_table(args: argparse.Namespace) -> int:
 def command_physics_table(args: argparse.Namespace) -> int:
     from anicov.physics_table import physics_table
 
-    return _shown(physics_table([Path(out) for out in args.out]), args.write)
+    return _shown(physics_table([Path(out) for out in args.out], args.seeds), args.write)
 
 
 def command_router(args: argparse.Namespace) -> int:
@@ -322,6 +322,9 @@ def _add_sweep(commands: argparse._SubParsersAction) -> None:
         "out", nargs="+", help="sweep output directories (sweeps/physics/*.toml): <map> and <map>-noise per map"
     )
     physics.add_argument("--write", help="also write the Markdown table to this file")
+    physics.add_argument(
+        "--seeds", type=int, metavar="K", help="only each table's seeds below K: every mode measured on the same runs"
+    )
     physics.set_defaults(handler=command_physics_table)
 
 

@@ -57,15 +57,17 @@ def _mode(row: dict[str, str], base: dict[str, Any]) -> str:
     return "noise" if any(value > 0.0 for key, value in noise.items() if key not in RULES) else "physics"
 
 
-def collect(out_dirs: list[Path]) -> dict[str, dict[tuple[int, str], Runs]]:
-    """Every sweep's rows: map → (team size, controller) → mode → runs, maps in the order first given."""
+def collect(out_dirs: list[Path], seeds: int | None = None) -> dict[str, dict[tuple[int, str], Runs]]:
+    """Every sweep's rows: map → (team size, controller) → mode → runs, maps in the order first given; with
+    ``seeds``, only seeds below it (a study whose modes ran to different seeds, compared on the same runs)."""
     maps: dict[str, dict[tuple[int, str], Runs]] = {}
     for out_dir in out_dirs:
         base = json.loads((out_dir / "sweep.json").read_text(encoding="utf-8"))["base"]
         groups = maps.setdefault(map_name(out_dir), defaultdict(lambda: defaultdict(list)))
         for key, rows in read_runs(out_dir).items():
             for row in rows:
-                groups[key][_mode(row, base)].append(row)
+                if seeds is None or int(row["seed"]) < seeds:
+                    groups[key][_mode(row, base)].append(row)
     return maps
 
 
@@ -138,10 +140,10 @@ def row_cells(name: str, agents: int, controller: str, runs: Runs) -> list[str]:
     ]
 
 
-def physics_table(out_dirs: list[Path]) -> str:
-    """The Markdown table of the sweeps in ``out_dirs`` (see the module)."""
+def physics_table(out_dirs: list[Path], seeds: int | None = None) -> str:
+    """The Markdown table of the sweeps in ``out_dirs`` (see the module), of their seeds below ``seeds`` if given."""
     lines = [HEADER, "|" + "---|" * HEADER.count(" | ") + "---|"]
-    for name, groups in collect(out_dirs).items():
+    for name, groups in collect(out_dirs, seeds).items():
         for agents, controller in sorted(groups):
             cells = row_cells(name, agents, controller, groups[(agents, controller)])
             lines.append("| " + " | ".join(cells) + " |")

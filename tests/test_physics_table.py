@@ -101,3 +101,13 @@ def test_a_sweep_whose_noise_holds_only_rules_is_physics_and_a_run_the_goals_can
     assert "physics: 1 runs without a true coverage" in row
     assert "physics: no complete kinematic run to time it against" in row
     assert "nan" not in row
+
+
+def test_seeds_below_k_compare_every_mode_on_the_same_runs(tmp_path):
+    """A study in stages may have run one mode to more seeds than another: ``seeds`` keeps the first K of each."""
+    dirs = rooms(tmp_path, [(4, "anicov", 0, True, 120.0, 0, 1.0), (4, "anicov", 1, True, 130.0, 0, 0.996)])
+    row = physics_table(dirs, seeds=1).splitlines()[2]
+    assert row == (
+        "| rooms | 4 | anicov | 100.0 | 105.0 (+5.0 %) | 120.0 (+20.0 %) | 1/1 / 1/1 / 1/1 | 0 / 0 "
+        "| 100.00 % / 100.00 % | missed: noise: +20.0 % over kinematic, not within 15 % |"
+    )
