@@ -12,9 +12,9 @@ from cryptography.hazmat.primitives.asymmetric import ec
 
 from anicov.secure import access_control, load_profile, make_profile
 from protocol.session import zenoh_config
-from tests.teamrun import anicov, free_port, launcher_command, processes_of, run, wait_for, write_scenario
+from tests.teamrun import anicov, free_port, launcher_command, processes_of, run, unique_team, wait_for, write_scenario
 
-TEAM = "sec"
+TEAM = unique_team()  # one per run: processes_of looks machine-wide, and another suite may run the same test
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +58,7 @@ def test_access_control_denies_by_default_and_gives_each_agent_only_its_keys():
 
 
 def test_a_profile_for_another_team_or_a_smaller_team_is_refused(profile):
-    with pytest.raises(ValueError, match="made for team 'sec', expected --team 'other'"):
+    with pytest.raises(ValueError, match=f"made for team '{TEAM}', expected --team 'other'"):
         load_profile(profile.directory, "other", 2)
     with pytest.raises(ValueError, match="certificates for 2 agents, expected >= 3"):
         load_profile(profile.directory, TEAM, 3)
@@ -143,4 +143,4 @@ def test_a_secure_team_runs_to_completion_and_equals_the_engine(tmp_path, profil
 def test_launcher_refuses_a_profile_of_another_team(tmp_path, profile):
     launched = run(launcher_command("--secure", str(profile.directory), "--out", str(tmp_path / "x"), team="other"))
     assert launched.returncode == 2
-    assert "made for team 'sec', expected --team 'other'" in launched.stderr
+    assert f"made for team '{TEAM}', expected --team 'other'" in launched.stderr
