@@ -53,9 +53,10 @@ measured on 2026-12-08 (a relieved robot keeps its patch; :func:`unsure_spread_o
 
 - 0.03 (the default until then): 5 of 15 runs ended short in truth, seed 11 by 2 cells of 372 (99.46 %, under
   the issue's 99.5 %); mean 160.0. The cells were short by 1 - 3 % of Λ*; of the 10 cells short in the study's
-  runs before (N = 1, 4, 10, seeds 0 - 14), 8 lay on the grid's edge: a robot drove along it, the cell ahead of it and off its axis, 0.3 - 1 away, and its belief
-  stayed 0.02 - 0.03 off the truth for the whole pass (the fused belief's error is slow), so the bearing's error,
-  δ / r, was the same way all along (seed 11, cell (0, 2): believed 1.053 Λ*, true 0.974 Λ*).
+  runs before (N = 1, 4, 10, seeds 0 - 14), 8 lay on the grid's edge: a robot drove along it, the cell ahead of it
+  and off its axis, 0.3 - 1 away, and its belief stayed 0.02 - 0.03 off the truth for the whole pass (the fused
+  belief's error is slow), so the bearing's error, δ / r, was the same way all along (seed 11, cell (0, 2):
+  believed 1.053 Λ*, true 0.974 Λ*).
 - 0.04: 1 run short, by 1 cell; mean 166.4. 0.05: none; 169.9.
 - Asking 0.05 more of the cells beside a wall or the grid's edge only: none short in the rooms (169.2), but on the
   paper's square (N = 10, seeds 0 - 2) the tails' lone edge cells then took 169.8 / 152.2 / 152.0 against 150.3 /

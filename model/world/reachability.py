@@ -37,21 +37,18 @@ def reachable_cells(
 
 @njit(cache=True)
 def _seen_from(
-    occupied: np.ndarray,
-    wall_grid: np.ndarray,
-    grain: float,
-    reachable: np.ndarray,
-    sensing_range: float,
-    cell: float,
-) -> np.ndarray:
-    """Free cells within R of a reachable cell's centre in clear sight. A reachable cell sees itself;
-    any other free cell looks for one reachable centre, stopping at the first (most cells are near one)."""
-    rows, cols = occupied.shape
+    candidates: np.ndarray, wall_grid: np.ndarray, grain: float, reachable: np.ndarray, sensing_range: float,
+    cell: float, spread: float = 0.0,
+) -> np.ndarray:  # fmt: skip
+    """The ``candidates`` that some reachable cell's centre sees: closer than R less ``spread``, in clear sight from
+    the centre and from the eight points ``spread`` off it (:func:`_clear_over`). A reachable cell sees itself; any
+    other looks for one reachable centre, stopping at the first (most cells are near one)."""
+    rows, cols = candidates.shape
     seen = reachable.copy()
     span = math.ceil(sensing_range / cell)
     for row in range(rows):
         for col in range(cols):
-            if seen[row, col] or occupied[row, col]:
+            if seen[row, col] or not candidates[row, col]:
                 continue
             tx, ty = (col + 0.5) * cell, (row + 0.5) * cell
             found = False
@@ -60,9 +57,9 @@ def _seen_from(
                     if not reachable[r, c]:
                         continue
                     x, y = (c + 0.5) * cell, (r + 0.5) * cell
-                    if math.hypot(tx - x, ty - y) >= sensing_range:
+                    if math.hypot(tx - x, ty - y) + spread >= sensing_range:
                         continue
-                    if not segment_crosses_occupied(wall_grid, x, y, tx, ty, grain):
+                    if _clear_over(wall_grid, x, y, tx, ty, grain, spread):
                         found = True
                         break
                 if found:
@@ -72,48 +69,27 @@ def _seen_from(
 
 
 @njit(cache=True)
-def _surely_seen(
-    wall_grid: np.ndarray, grain: float, reachable: np.ndarray, coverable: np.ndarray, sensing_range: float, cell: float,
-    spread: float,
-) -> np.ndarray:  # fmt: skip
-    """Coverable cells that some reachable cell sees from its centre and from the eight points ``spread`` off it
-    (every 45°), each closer than ``sensing_range`` less ``spread`` in clear sight; a reachable cell sees itself."""
-    rows, cols = coverable.shape
-    seen = reachable & coverable
-    span = math.ceil(sensing_range / cell)
-    for row in range(rows):
-        for col in range(cols):
-            if seen[row, col] or not coverable[row, col]:
-                continue
-            tx, ty = (col + 0.5) * cell, (row + 0.5) * cell
-            for r in range(max(row - span, 0), min(row + span + 1, rows)):
-                for c in range(max(col - span, 0), min(col + span + 1, cols)):
-                    x, y = (c + 0.5) * cell, (r + 0.5) * cell
-                    if not reachable[r, c] or math.hypot(tx - x, ty - y) + spread >= sensing_range:
-                        continue
-                    sure = not segment_crosses_occupied(wall_grid, x, y, tx, ty, grain)
-                    for way in range(8):
-                        if not sure:
-                            break
-                        u, v = math.cos(way * math.pi / 4), math.sin(way * math.pi / 4)
-                        sure = not segment_crosses_occupied(wall_grid, x + spread * u, y + spread * v, tx, ty, grain)
-                    if sure:
-                        seen[row, col] = True
-                        break
-                if seen[row, col]:
-                    break
-    return seen
+def _clear_over(wall_grid: np.ndarray, x: float, y: float, tx: float, ty: float, grain: float, spread: float) -> bool:
+    """Clear sight to (tx, ty) from (x, y) and, ``spread`` > 0, from the eight points ``spread`` off it (every 45°)."""
+    if segment_crosses_occupied(wall_grid, x, y, tx, ty, grain):
+        return False
+    if spread > 0.0:
+        for way in range(8):
+            u, v = math.cos(way * math.pi / 4), math.sin(way * math.pi / 4)
+            if segment_crosses_occupied(wall_grid, x + spread * u, y + spread * v, tx, ty, grain):
+                return False
+    return True
 
 
 def unsure_cells(
     wall_grid: np.ndarray, grain: float, reachable: np.ndarray, coverable: np.ndarray, sensing_range: float, cell: float,
     spread: float,
 ) -> np.ndarray:  # fmt: skip
-    """Coverable cells that no reachable cell sees surely over ``spread`` (:func:`_surely_seen`): seen only through
-    a gap between walls, from a point a robot must stand on to better than ``spread``. None where ``spread`` is 0."""
+    """Coverable cells that no reachable cell sees surely over ``spread`` (:func:`_seen_from`): seen only through a
+    gap between walls, from a point a robot must stand on to better than ``spread``. None where ``spread`` is 0."""
     if spread <= 0.0:
         return np.zeros_like(coverable)
-    return coverable & ~_surely_seen(wall_grid, grain, reachable, coverable, sensing_range, cell, spread)
+    return coverable & ~_seen_from(coverable, wall_grid, grain, reachable, sensing_range, cell, spread)
 
 
 def coverable_cells(
@@ -129,7 +105,7 @@ def coverable_cells(
     grain = cell if grain is None else grain
     occupied = coarsen(wall_grid, round(cell / grain))
     reachable = reachable_cells(passable, starts, cell, graph)
-    return _seen_from(occupied, wall_grid, grain, reachable, sensing_range, cell)
+    return _seen_from(~occupied, wall_grid, grain, reachable, sensing_range, cell)
 
 
 def in_reachable_cell(reachable: np.ndarray, x: float, y: float, cell: float) -> bool:

@@ -108,8 +108,9 @@ class World:
     @functools.cached_property
     def unsure(self) -> np.ndarray:
         """Coverable cells a robot cannot be sure to see with a localiser's noise: no reachable cell sees them from its
-        centre and from the eight points :func:`model.scenario.physics_keys.unsure_spread_of` off it (:func:`model.world.reachability.unsure_cells`). The
-        team's map does not ask them (:func:`model.parameters.coverage_map_of`); the truth's still counts them."""
+        centre and from the eight points :func:`model.scenario.physics_keys.unsure_spread_of` off it
+        (:func:`model.world.reachability.unsure_cells`). The team's map does not ask them
+        (:func:`model.parameters.coverage_map_of`); the truth's still counts them."""
         scenario = self.scenario
         return unsure_cells(
             self.wall_grid, self.grain, self.reachable, self.coverable, viewing_range_of(scenario), scenario.cell,
